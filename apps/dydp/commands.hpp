@@ -1,0 +1,24 @@
+// The dydp subcommands, each a function of its parsed arguments returning the exit status.
+#pragma once
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace dydp::apps {
+
+struct RunArgs {
+  std::string scene;
+  std::string out = "out";
+  std::vector<std::string> sets;  ///< NAME=VALUE
+  bool no_sens = false;
+  bool report = false;
+};
+
+int run_command(const RunArgs& args);
+int blocks_command(std::ostream& out);
+
+/// Splits NAME=VALUE pairs; throws InputError naming --set on a malformed one.
+std::vector<std::pair<std::string, std::string>> parse_sets(const std::vector<std::string>& sets);
+
+}  // namespace dydp::apps

@@ -1,0 +1,47 @@
+// dydp: runs scenes (values, sensitivities, objectives) and lists the block library.
+// Exit status: 0 success, 2 bad input (file:line: message on stderr), 1 solver failure.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <iostream>
+
+#include "apps/dydp/commands.hpp"
+#include "engine/errors.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"dydp: exact sensitivities of vehicle comfort and handling to design parameters"};
+  app.require_subcommand(1);
+
+  dydp::apps::RunArgs run_args;
+  CLI::App* run = app.add_subcommand("run", "Run a scene: signals, sensitivities, objectives");
+  run->add_option("scene", run_args.scene, "scene file (YAML)")->required();
+  run->add_option("--out", run_args.out, "output folder")->capture_default_str();
+  run->add_option("--set", run_args.sets, "override a scene parameter: NAME=VALUE");
+  run->add_flag("--no-sens", run_args.no_sens, "run without sensitivities");
+  run->add_flag("--report", run_args.report, "also write plots (gnuplot) and report.md");
+
+  CLI::App* blocks = app.add_subcommand("blocks", "List the block types with ports and parameters");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+
+  try {
+    if (*run) return dydp::apps::run_command(run_args);
+    if (*blocks) return dydp::apps::blocks_command(std::cout);
+  } catch (const dydp::engine::InputError& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  } catch (const dydp::engine::SolverError& e) {
+    std::cerr << "solver failure: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,109 @@
+#include "apps/dydp/report.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <iomanip>
+#include <sstream>
+
+#include "engine/output_writer.hpp"
+
+namespace dydp::apps {
+namespace {
+
+std::string file_safe(const std::string& name) {
+  std::string s;
+  for (char c : name) s += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return s;
+}
+
+std::string unit_of(const engine::Diagram& d, const std::string& signal) {
+  const std::string port = signal.substr(0, signal.find('['));
+  const auto dot = port.find('.');
+  for (const auto& n : d.nodes)
+    if (n.name == port.substr(0, dot))
+      for (const auto& p : n.block->outputs())
+        if (p.name == port.substr(dot + 1)) return p.unit;
+  return "";
+}
+
+bool have_gnuplot() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
+
+}  // namespace
+
+void write_report(const std::string& dir, const engine::Diagram& d, const engine::RunResult& r) {
+  namespace fs = std::filesystem;
+  const int nsig = r.num_signals();
+  const int ns = static_cast<int>(r.sensitivity_names.size());
+  std::ostringstream md;
+  md << std::setprecision(6);
+  md << "# " << d.scene_name << "\n\n";
+  md << "Scene `" << d.file << "`, " << r.stats.method << " (rtol " << r.stats.rtol << ", atol "
+     << r.stats.atol << "): " << r.stats.steps << " steps, " << r.stats.cpu_seconds
+     << " CPU s for " << r.stats.simulated_seconds << " s simulated, " << r.stats.realtime_factor
+     << "x real time.\n\n";
+
+  md << "## Parameters\n\n| parameter | value | unit | sensitivity direction |\n|---|---|---|---|\n";
+  for (size_t i = 0; i < d.parameters.size(); ++i) {
+    const auto& p = d.parameters[i];
+    bool dir = false;
+    for (const auto& s : r.sensitivity_names) dir = dir || s == p.name;
+    md << "| " << p.name << " | " << p.value << " | " << p.unit << " | " << (dir ? "yes" : "") << " |\n";
+  }
+
+  if (!r.objectives.empty()) {
+    md << "\n## Objectives\n\nNormalised sensitivity: (p / psi) d(psi)/dp, the % change of psi for "
+          "1 % change of p.\n\n| objective | psi | parameter | d(psi)/dp | normalised |\n|---|---|---|---|---|\n";
+    for (const auto& o : r.objectives) {
+      if (ns == 0) md << "| " << o.name << " | " << o.value << " | | | |\n";
+      for (int k = 0; k < ns; ++k) {
+        const double p = d.parameters[d.find_parameter(r.sensitivity_names[k])].value;
+        md << "| " << o.name << " | " << o.value << " | " << r.sensitivity_names[k] << " | "
+           << o.sensitivity[k] << " | " << (o.value != 0 ? p / o.value * o.sensitivity[k] : 0.0)
+           << " |\n";
+      }
+    }
+  }
+
+  md << "\n## Signals\n\n";
+  if (!have_gnuplot()) {
+    md << "gnuplot was not found on the PATH: no plots were made (install gnuplot-nox).\n";
+  } else {
+    fs::create_directories(dir + "/plots");
+    std::ostringstream gp;
+    gp << "set terminal pngcairo size 900,640 font 'Sans,10'\nset datafile separator ','\n"
+          "set grid\nset key outside right top\n";
+    for (int i = 0; i < nsig; ++i) {
+      const std::string& name = r.signal_names[i];
+      const std::string unit = unit_of(d, name);
+      const std::string png = "plots/" + file_safe(name) + ".png";
+      gp << "set output '" << dir << "/" << png << "'\n";
+      gp << "set multiplot layout " << (ns > 0 ? 2 : 1) << ",1 title '" << name << "'\n";
+      gp << "set xlabel 't [s]'\nset ylabel '" << name << (unit.empty() ? "" : " [" + unit + "]") << "'\n";
+      gp << "plot '" << dir << "/signals.csv' every ::1 using 1:" << i + 2 << " with lines lw 1.5 title 'value'\n";
+      if (ns > 0) {
+        gp << "set ylabel 'p * d(" << name << ")/dp" << (unit.empty() ? "" : " [" + unit + "]") << "'\n";
+        gp << "plot ";
+        for (int k = 0; k < ns; ++k) {
+          const double p = d.parameters[d.find_parameter(r.sensitivity_names[k])].value;
+          gp << (k ? ", " : "") << "'" << dir << "/signals.csv' every ::1 using 1:($"
+             << 2 + nsig * (k + 1) + i << "*" << std::setprecision(17) << p << ") with lines lw 1.5 title '"
+             << r.sensitivity_names[k] << "'";
+        }
+        gp << "\n";
+      }
+      gp << "unset multiplot\n";
+      md << "### " << name << "\n\n![" << name << "](" << png << ")\n\n";
+    }
+    const std::string script = dir + "/plots/report.gp";
+    engine::write_file_atomically(script, gp.str());
+    if (std::system(("gnuplot '" + script + "' 2>" + dir + "/plots/gnuplot.log").c_str()) != 0)
+      md << "gnuplot failed: see plots/gnuplot.log.\n";
+  }
+  if (ns > 0)
+    md << "Lower panels: sensitivities scaled by their parameter's value, p * dS/dp, the change of S "
+          "(in its unit) for a 100 % change of p, to first order.\n";
+  engine::write_file_atomically(dir + "/report.md", md.str());
+}
+
+}  // namespace dydp::apps

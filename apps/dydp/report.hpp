@@ -1,0 +1,16 @@
+// --report: plots of every logged signal and its normalised sensitivities (gnuplot PNG) and a
+// report.md that links them with the objectives and run figures.
+#pragma once
+
+#include <string>
+
+#include "engine/diagram.hpp"
+#include "engine/run.hpp"
+
+namespace dydp::apps {
+
+/// Writes DIR/report.md and DIR/plots/*.png (needs DIR/signals.csv, written before).
+/// Without gnuplot on the PATH, report.md says so and no plot is made.
+void write_report(const std::string& dir, const engine::Diagram& d, const engine::RunResult& r);
+
+}  // namespace dydp::apps

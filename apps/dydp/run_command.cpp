@@ -1,0 +1,67 @@
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+
+#include "apps/dydp/commands.hpp"
+#include "apps/dydp/report.hpp"
+#include "engine/errors.hpp"
+#include "engine/output_writer.hpp"
+#include "engine/run.hpp"
+
+namespace dydp::apps {
+
+std::vector<std::pair<std::string, std::string>> parse_sets(const std::vector<std::string>& sets) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const std::string& s : sets) {
+    const auto eq = s.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw engine::InputError("--set", 0, s, "expected NAME=VALUE");
+    out.emplace_back(s.substr(0, eq), s.substr(eq + 1));
+  }
+  return out;
+}
+
+int run_command(const RunArgs& args) {
+  engine::Diagram d = engine::load_scene(args.scene, parse_sets(args.sets));
+
+  engine::RunOptions options;
+  options.sensitivities = !args.no_sens;
+  const bool tty = isatty(fileno(stderr));
+  int last_percent = -1;
+  options.progress = [&](double t) {
+    const int percent = static_cast<int>(100 * (t - d.time.start) / (d.time.stop - d.time.start));
+    if (!tty || percent == last_percent) return;
+    last_percent = percent;
+    std::cerr << "\r" << d.scene_name << ": t = " << std::fixed << std::setprecision(2) << t
+              << " s  [" << percent << "%]" << std::flush;
+  };
+  const engine::RunResult r = engine::run(d, options);
+  if (tty) std::cerr << "\r" << std::string(60, ' ') << "\r";
+
+  engine::write_outputs(args.out, d, r);
+  if (args.report) write_report(args.out, d, r);
+
+  std::cout << d.scene_name << ": " << r.stats.method << ", " << r.stats.steps << " steps, "
+            << std::setprecision(3) << r.stats.cpu_seconds << " CPU s for "
+            << r.stats.simulated_seconds << " s simulated (" << std::setprecision(4)
+            << r.stats.realtime_factor << "x real time)\n";
+  for (const auto& o : r.objectives) {
+    std::cout << "  " << o.name << " = " << std::setprecision(6) << o.value;
+    for (size_t k = 0; k < o.sensitivity.size(); ++k)
+      std::cout << "   d/d" << r.sensitivity_names[k] << " = " << o.sensitivity[k];
+    std::cout << "\n";
+  }
+  if (!d.pruned.empty()) {
+    std::cout << "  pruned (no requested output needs them):";
+    for (const auto& p : d.pruned) std::cout << " " << p;
+    std::cout << "\n";
+  }
+  std::cout << "  results in " << args.out << "/ (signals.csv, objectives.json, run.json"
+            << (args.report ? ", report.md" : "") << ")\n";
+  return 0;
+}
+
+}  // namespace dydp::apps

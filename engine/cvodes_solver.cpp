@@ -1,0 +1,350 @@
+// CVODES (BDF or Adams) with forward sensitivities by the direct method: the sensitivity
+// right-hand side is the diagram's tangent pass, corrected simultaneously with the states and
+// included in the error test; the Newton matrix is the exact Jacobian from tangent passes over
+// the states; objective integrals are quadratures with their own sensitivities.
+#include "engine/cvodes_solver.hpp"
+
+#include <cvodes/cvodes.h>
+#include <nvector/nvector_serial.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "engine/cpu_clock.hpp"
+#include "engine/errors.hpp"
+#include "engine/output_grid.hpp"
+#include "engine/recorder.hpp"
+
+namespace dydp::engine {
+namespace {
+
+/// What the C callbacks need, and what they found when they had to refuse a point.
+struct Problem {
+  const Diagram& d;
+  Evaluator& ev;
+  int nx;                 ///< states of the diagram (CVODES gets max(nx, 1))
+  int ns;
+  std::vector<double> dx, dxdot, identity;
+  std::string refusal;    ///< last block that refused a point: "block: reason"
+  double refusal_t = 0.0;
+  std::string cvodes_message;
+  long sens_passes = 0;
+  long jac_passes = 0;
+
+  void refuse(double t, std::string why) {
+    refusal = std::move(why);
+    refusal_t = t;
+  }
+};
+
+/// Copies N_Vector columns into a d-major buffer and back.
+void gather(N_Vector* v, int n, int count, std::vector<double>& out) {
+  out.resize(static_cast<size_t>(n) * count);
+  for (int c = 0; c < count; ++c) std::copy_n(NV_DATA_S(v[c]), n, out.data() + c * n);
+}
+void scatter(const std::vector<double>& in, int n, int count, N_Vector* v) {
+  for (int c = 0; c < count; ++c) std::copy_n(in.data() + c * n, n, NV_DATA_S(v[c]));
+}
+
+int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
+  auto& P = *static_cast<Problem*>(user);
+  double* xdot = NV_DATA_S(ydot);
+  if (P.nx == 0) xdot[0] = 0.0;
+  try {
+    P.ev.derivatives(t, NV_DATA_S(y), xdot);
+  } catch (const OutOfDomain& e) {
+    P.refuse(t, e.reason);
+    return 1;
+  } catch (const std::exception& e) {
+    P.refuse(t, e.what());
+    return -1;
+  }
+  const std::string bad = P.ev.find_nonfinite(xdot);
+  if (!bad.empty()) {
+    P.refuse(t, bad);
+    return 1;  // recoverable: CVODES retries with a smaller step, then fails naming it
+  }
+  return 0;
+}
+
+int sens_rhs(int ns, sunrealtype t, N_Vector y, N_Vector, N_Vector* yS, N_Vector* ySdot,
+             void* user, N_Vector, N_Vector) {
+  auto& P = *static_cast<Problem*>(user);
+  try {
+    gather(yS, P.nx, ns, P.dx);
+    P.dxdot.assign(static_cast<size_t>(P.nx) * ns, 0.0);
+    P.ev.tangents(t, NV_DATA_S(y), ns, {P.dx.data(), P.nx}, true, {P.dxdot.data(), P.nx}, {});
+    if (P.nx > 0) scatter(P.dxdot, P.nx, ns, ySdot);
+    ++P.sens_passes;
+  } catch (const OutOfDomain& e) {
+    P.refuse(t, e.reason);
+    return 1;
+  } catch (const std::exception& e) {
+    P.refuse(t, e.what());
+    return -1;
+  }
+  return 0;
+}
+
+int jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix J, void* user, N_Vector, N_Vector,
+             N_Vector) {
+  auto& P = *static_cast<Problem*>(user);
+  SUNMatZero(J);
+  if (P.nx == 0) return 0;
+  try {
+    P.ev.tangents(t, NV_DATA_S(y), P.nx, {P.identity.data(), P.nx}, false,
+                  {SM_DATA_D(J), static_cast<int>(SM_ROWS_D(J))}, {});
+    ++P.jac_passes;
+  } catch (const OutOfDomain& e) {
+    P.refuse(t, e.reason);
+    return 1;
+  } catch (const std::exception& e) {
+    P.refuse(t, e.what());
+    return -1;
+  }
+  return 0;
+}
+
+int quad_rhs(sunrealtype t, N_Vector y, N_Vector qdot, void* user) {
+  auto& P = *static_cast<Problem*>(user);
+  try {
+    P.ev.quadratures(t, NV_DATA_S(y), NV_DATA_S(qdot));
+  } catch (const OutOfDomain& e) {
+    P.refuse(t, e.reason);
+    return 1;
+  }
+  return 0;
+}
+
+int quad_sens_rhs(int ns, sunrealtype t, N_Vector y, N_Vector* yS, N_Vector, N_Vector* yQSdot,
+                  void* user, N_Vector, N_Vector) {
+  auto& P = *static_cast<Problem*>(user);
+  const int nq = P.d.num_quadratures;
+  try {
+    gather(yS, P.nx, ns, P.dx);
+    std::vector<double> dq(static_cast<size_t>(nq) * ns, 0.0);
+    P.ev.tangents(t, NV_DATA_S(y), ns, {P.dx.data(), P.nx}, true, {}, {dq.data(), nq});
+    scatter(dq, nq, ns, yQSdot);
+  } catch (const OutOfDomain& e) {
+    P.refuse(t, e.reason);
+    return 1;
+  }
+  return 0;
+}
+
+void error_handler(int, const char* module, const char* function, char* msg, void* user) {
+  static_cast<Problem*>(user)->cvodes_message = std::string(function) + ": " + msg;
+}
+
+/// Owns the SUNDIALS objects of one run and releases them in the right order.
+struct Sundials {
+  SUNContext ctx = nullptr;
+  void* mem = nullptr;
+  N_Vector y = nullptr, yq = nullptr;
+  N_Vector* ys = nullptr;
+  N_Vector* yqs = nullptr;
+  int ns = 0;
+  SUNMatrix A = nullptr;
+  SUNLinearSolver LS = nullptr;
+  SUNNonlinearSolver NLS = nullptr, NLSsens = nullptr;
+
+  ~Sundials() {
+    if (mem) CVodeFree(&mem);
+    if (ys) N_VDestroyVectorArray(ys, ns);
+    if (yqs) N_VDestroyVectorArray(yqs, ns);
+    if (y) N_VDestroy(y);
+    if (yq) N_VDestroy(yq);
+    if (LS) SUNLinSolFree(LS);
+    if (A) SUNMatDestroy(A);
+    if (NLS) SUNNonlinSolFree(NLS);
+    if (NLSsens) SUNNonlinSolFree(NLSsens);
+    if (ctx) SUNContext_Free(&ctx);
+  }
+};
+
+}  // namespace
+
+RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
+  const bool bdf = d.solver.method == "bdf";
+  const int nx = d.num_states, nq = d.num_quadratures;
+  const int ns = options.sensitivities ? static_cast<int>(d.sensitivities.size()) : 0;
+  const int n_cv = std::max(nx, 1);
+  const double t0 = d.time.start, tf = d.time.stop;
+
+  Evaluator ev(d, ns > 0);
+  RunResult result;
+  Recorder recorder(d, ns, result);
+  Problem P{d, ev, nx, ns, {}, {}, {}, {}, 0.0, {}, 0, 0};
+  P.identity.assign(static_cast<size_t>(nx) * nx, 0.0);
+  for (int i = 0; i < nx; ++i) P.identity[i * nx + i] = 1.0;
+  const CpuClock clock;
+
+  Sundials S;
+  S.ns = ns;
+  auto check = [&](int flag, const char* call) {
+    if (flag < 0)
+      throw SolverError(t0, "", std::string(call) + " failed: " + CVodeGetReturnFlagName(flag) +
+                                    (P.cvodes_message.empty() ? "" : " (" + P.cvodes_message + ")"));
+  };
+  check(SUNContext_Create(nullptr, &S.ctx), "SUNContext_Create");
+  S.y = N_VNew_Serial(n_cv, S.ctx);
+  N_VConst(0.0, S.y);
+  ev.set_segment_start(t0);
+  ev.initial_state(t0, NV_DATA_S(S.y));
+
+  S.mem = CVodeCreate(bdf ? CV_BDF : CV_ADAMS, S.ctx);
+  if (!S.mem) throw SolverError(t0, "", "CVodeCreate failed");
+  check(CVodeSetErrHandlerFn(S.mem, error_handler, &P), "CVodeSetErrHandlerFn");
+  check(CVodeInit(S.mem, rhs, t0, S.y), "CVodeInit");
+  check(CVodeSetUserData(S.mem, &P), "CVodeSetUserData");
+  check(CVodeSStolerances(S.mem, d.solver.rtol, d.solver.atol), "CVodeSStolerances");
+  check(CVodeSetMaxNumSteps(S.mem, d.solver.max_steps), "CVodeSetMaxNumSteps");
+  if (bdf) {
+    S.A = SUNDenseMatrix(n_cv, n_cv, S.ctx);
+    S.LS = SUNLinSol_Dense(S.y, S.A, S.ctx);
+    check(CVodeSetLinearSolver(S.mem, S.LS, S.A), "CVodeSetLinearSolver");
+    check(CVodeSetJacFn(S.mem, jacobian), "CVodeSetJacFn");
+  } else {
+    S.NLS = SUNNonlinSol_FixedPoint(S.y, 0, S.ctx);
+    check(CVodeSetNonlinearSolver(S.mem, S.NLS), "CVodeSetNonlinearSolver");
+  }
+
+  // Sensitivity tolerances scaled by the parameter values (the pbar of CVODES' guide), so
+  // dx/dk for a stiffness of 1e5 N/m is held to the same relative accuracy as dx/dm.
+  std::vector<double> atol_s(ns);
+  for (int dir = 0; dir < ns; ++dir) {
+    const double pv = std::fabs(d.parameters[d.sensitivities[dir]].value);
+    atol_s[dir] = d.solver.atol / (pv > 0 ? pv : 1.0);
+  }
+  if (ns > 0) {
+    S.ys = N_VCloneVectorArray(ns, S.y);
+    std::vector<double> dx0(static_cast<size_t>(nx) * ns, 0.0);
+    ev.initial_state_tangent(t0, NV_DATA_S(S.y), {dx0.data(), nx});
+    for (int dir = 0; dir < ns; ++dir) N_VConst(0.0, S.ys[dir]);
+    if (nx > 0) scatter(dx0, nx, ns, S.ys);
+    check(CVodeSensInit(S.mem, ns, CV_SIMULTANEOUS, sens_rhs, S.ys), "CVodeSensInit");
+    check(CVodeSensSStolerances(S.mem, d.solver.rtol, atol_s.data()), "CVodeSensSStolerances");
+    check(CVodeSetSensErrCon(S.mem, SUNTRUE), "CVodeSetSensErrCon");
+    if (!bdf) {
+      S.NLSsens = SUNNonlinSol_FixedPointSens(ns + 1, S.y, 0, S.ctx);
+      check(CVodeSetNonlinearSolverSensSim(S.mem, S.NLSsens), "CVodeSetNonlinearSolverSensSim");
+    }
+  }
+  if (nq > 0) {
+    S.yq = N_VNew_Serial(nq, S.ctx);
+    N_VConst(0.0, S.yq);
+    check(CVodeQuadInit(S.mem, quad_rhs, S.yq), "CVodeQuadInit");
+    check(CVodeQuadSStolerances(S.mem, d.solver.rtol, d.solver.atol), "CVodeQuadSStolerances");
+    check(CVodeSetQuadErrCon(S.mem, SUNTRUE), "CVodeSetQuadErrCon");
+    if (ns > 0) {
+      S.yqs = N_VCloneVectorArray(ns, S.yq);
+      for (int dir = 0; dir < ns; ++dir) N_VConst(0.0, S.yqs[dir]);
+      check(CVodeQuadSensInit(S.mem, quad_sens_rhs, S.yqs), "CVodeQuadSensInit");
+      check(CVodeQuadSensSStolerances(S.mem, d.solver.rtol, atol_s.data()),
+            "CVodeQuadSensSStolerances");
+      check(CVodeSetQuadSensErrCon(S.mem, SUNTRUE), "CVodeSetQuadSensErrCon");
+    }
+  }
+
+  RunStats& st = result.stats;
+  auto accumulate = [&] {
+    long v = 0;
+    CVodeGetNumSteps(S.mem, &v), st.steps += v;
+    CVodeGetNumRhsEvals(S.mem, &v), st.rhs_evals += v;
+    CVodeGetNumErrTestFails(S.mem, &v), st.error_test_failures += v;
+    CVodeGetNumNonlinSolvIters(S.mem, &v), st.nonlinear_iterations += v;
+    if (bdf) CVodeGetNumJacEvals(S.mem, &v), st.jac_evals += v;
+  };
+
+  // Record at t0, then march over outputs and breakpoints; restart CVODES after each breakpoint
+  // since the right-hand side may jump there.
+  auto record = [&](double t) {
+    std::vector<double> dx;
+    if (ns > 0) {
+      sunrealtype tret = t;
+      if (t > t0) check(CVodeGetSens(S.mem, &tret, S.ys), "CVodeGetSens");
+      gather(S.ys, nx, ns, dx);
+      ev.tangents(t, NV_DATA_S(S.y), ns, {dx.data(), nx}, true, {}, {});
+    } else {
+      ev.outputs(t, NV_DATA_S(S.y));
+    }
+    recorder.record(t, NV_DATA_S(S.y), ev);
+    if (options.progress) options.progress(t);
+  };
+  record(t0);
+
+  const std::vector<double> outputs = output_grid(d.time);
+  const std::vector<double> breaks = d.breakpoints(t0, tf);
+  std::vector<double> events(outputs.begin() + 1, outputs.end());
+  events.insert(events.end(), breaks.begin(), breaks.end());
+  std::sort(events.begin(), events.end());
+  events.erase(std::unique(events.begin(), events.end()), events.end());
+
+  double t = t0;
+  size_t next_break = 0, next_output = 1;
+  for (double target : events) {
+    while (next_break < breaks.size() && breaks[next_break] < target) ++next_break;
+    const double stop = next_break < breaks.size() ? breaks[next_break] : tf;
+    check(CVodeSetStopTime(S.mem, stop), "CVodeSetStopTime");
+    const int flag = CVode(S.mem, target, S.y, &t, CV_NORMAL);
+    if (flag < 0) {
+      std::string reason = std::string("CVode failed: ") + CVodeGetReturnFlagName(flag);
+      if (!P.cvodes_message.empty()) reason += " (" + P.cvodes_message + ")";
+      std::string block;
+      if (!P.refusal.empty()) {
+        block = P.refusal.substr(0, P.refusal.find(':'));
+        reason += "; last refused point at t = " + std::to_string(P.refusal_t) + " s: " + P.refusal;
+      }
+      throw SolverError(t, block, reason);
+    }
+    t = target;
+    if (next_output < outputs.size() && outputs[next_output] == target) {
+      record(target);
+      ++next_output;
+    }
+    if (next_break < breaks.size() && breaks[next_break] == target && target < tf) {
+      accumulate();
+      ev.set_segment_start(target);
+      check(CVodeReInit(S.mem, target, S.y), "CVodeReInit");
+      if (ns > 0) {
+        CVodeGetSens(S.mem, &t, S.ys);
+        check(CVodeSensReInit(S.mem, CV_SIMULTANEOUS, S.ys), "CVodeSensReInit");
+      }
+      if (nq > 0) {
+        check(CVodeGetQuad(S.mem, &t, S.yq), "CVodeGetQuad");
+        if (ns > 0) check(CVodeGetQuadSens(S.mem, &t, S.yqs), "CVodeGetQuadSens");
+        check(CVodeQuadReInit(S.mem, S.yq), "CVodeQuadReInit");
+        if (ns > 0) check(CVodeQuadSensReInit(S.mem, S.yqs), "CVodeQuadSensReInit");
+      }
+      t = target;
+    }
+  }
+  accumulate();
+  st.sens_rhs_evals = P.sens_passes;
+
+  std::vector<double> q(std::max(nq, 1), 0.0), dq(static_cast<size_t>(std::max(nq, 1)) * ns, 0.0);
+  if (nq > 0) {
+    check(CVodeGetQuad(S.mem, &t, S.yq), "CVodeGetQuad");
+    std::copy_n(NV_DATA_S(S.yq), nq, q.data());
+    if (ns > 0) {
+      check(CVodeGetQuadSens(S.mem, &t, S.yqs), "CVodeGetQuadSens");
+      gather(S.yqs, nq, ns, dq);
+    }
+  }
+  recorder.finish(q.data(), {dq.data(), std::max(nq, 1)});
+  result.final_state.assign(NV_DATA_S(S.y), NV_DATA_S(S.y) + nx);
+
+  st.method = d.solver.method;
+  st.rtol = d.solver.rtol;
+  st.atol = d.solver.atol;
+  st.cpu_seconds = clock.seconds();
+  st.simulated_seconds = tf - t0;
+  st.realtime_factor = st.cpu_seconds > 0 ? st.simulated_seconds / st.cpu_seconds : 0.0;
+  return result;
+}
+
+}  // namespace dydp::engine

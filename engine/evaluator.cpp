@@ -1,0 +1,148 @@
+#include "engine/evaluator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace dydp::engine {
+
+Evaluator::Evaluator(const Diagram& d, bool with_sensitivities)
+    : d_(d), ns_(with_sensitivities ? static_cast<int>(d.sensitivities.size()) : 0),
+      sig_(d.num_signals, 0.0), last_x_(d.num_states, 0.0) {
+  size_t max_ports = 1;
+  for (const Node& n : d.nodes) {
+    pseed_offset_.push_back(static_cast<int>(pseed_.size()));
+    const int np = static_cast<int>(n.p.size());
+    for (int dir = 0; dir < ns_; ++dir)
+      for (int j = 0; j < np; ++j) pseed_.push_back(d.parameter_seed(n, j, dir));
+    u_offset_.push_back(static_cast<int>(u_.size()));
+    for (int src : n.input_source) u_.push_back(sig_.data() + src);
+    max_ports = std::max({max_ports, n.block->inputs().size(), n.block->outputs().size()});
+  }
+  du_.resize(max_ports);
+  dy_.resize(max_ports);
+  y_.resize(max_ports);
+}
+
+Eval Evaluator::eval_for(const Node& n, int index, double t, const double* x) const {
+  Eval e;
+  e.t = t;
+  e.segment_start = segment_start_;
+  e.x = x ? x + n.state_offset : nullptr;
+  e.u = u_.data() + u_offset_[index];
+  e.p = n.p.data();
+  return e;
+}
+
+Seeds Evaluator::seeds_for(const Node& n, int index, int nd, ConstDirView dx, bool with_params) {
+  const int ld = d_.num_signals;
+  for (size_t k = 0; k < n.input_source.size(); ++k)
+    du_[k] = {dsig_.data() + n.input_source[k], ld};
+  Seeds s;
+  s.directions = nd;
+  s.x = dx.zero() || n.block->num_states() == 0 ? ConstDirView{}
+                                                 : ConstDirView{dx.data + n.state_offset, dx.ld};
+  s.u = du_.data();
+  const bool any_param = with_params && !n.p.empty() &&
+      std::any_of(n.p_scene.begin(), n.p_scene.end(), [](int i) { return i >= 0; });
+  s.p = any_param ? ConstDirView{pseed_.data() + pseed_offset_[index], static_cast<int>(n.p.size())}
+                  : ConstDirView{};
+  return s;
+}
+
+void Evaluator::initial_state(double t0, double* x0) {
+  std::fill(x0, x0 + d_.num_states, 0.0);
+  for (size_t i = 0; i < d_.nodes.size(); ++i) {
+    const Node& n = d_.nodes[i];
+    if (n.block->num_states() == 0) continue;
+    n.block->initial_state(eval_for(n, static_cast<int>(i), t0, x0), x0 + n.state_offset);
+  }
+}
+
+void Evaluator::initial_state_tangent(double t0, const double* x0, DirView dx0) {
+  for (int dir = 0; dir < ns_; ++dir)
+    std::fill(dx0.data + dir * dx0.ld, dx0.data + dir * dx0.ld + d_.num_states, 0.0);
+  if (ns_ == 0) return;
+  dsig_.assign(static_cast<size_t>(d_.num_signals) * ns_, 0.0);
+  for (size_t i = 0; i < d_.nodes.size(); ++i) {
+    const Node& n = d_.nodes[i];
+    if (n.block->num_states() == 0) continue;
+    const Seeds s = seeds_for(n, static_cast<int>(i), ns_, {}, true);
+    n.block->initial_state_tangent(eval_for(n, static_cast<int>(i), t0, x0), s,
+                                   {dx0.data + n.state_offset, dx0.ld});
+  }
+}
+
+void Evaluator::outputs(double t, const double* x) {
+  const int nx = d_.num_states;
+  if (valid_ && t == last_t_ && (nx == 0 || std::memcmp(x, last_x_.data(), nx * sizeof(double)) == 0))
+    return;
+  for (size_t i = 0; i < d_.nodes.size(); ++i) {
+    const Node& n = d_.nodes[i];
+    for (size_t k = 0; k < n.output_offset.size(); ++k) y_[k] = sig_.data() + n.output_offset[k];
+    n.block->outputs(eval_for(n, static_cast<int>(i), t, x), y_.data());
+  }
+  valid_ = true;
+  last_t_ = t;
+  if (nx) std::memcpy(last_x_.data(), x, nx * sizeof(double));
+}
+
+void Evaluator::derivatives(double t, const double* x, double* xdot) {
+  outputs(t, x);
+  for (size_t i = 0; i < d_.nodes.size(); ++i) {
+    const Node& n = d_.nodes[i];
+    if (n.block->num_states() == 0) continue;
+    n.block->derivatives(eval_for(n, static_cast<int>(i), t, x), xdot + n.state_offset);
+  }
+}
+
+void Evaluator::quadratures(double t, const double* x, double* qdot) {
+  outputs(t, x);
+  for (size_t i = 0; i < d_.nodes.size(); ++i) {
+    const Node& n = d_.nodes[i];
+    if (n.block->num_quadratures() == 0) continue;
+    n.block->quadratures(eval_for(n, static_cast<int>(i), t, x), qdot + n.quad_offset);
+  }
+}
+
+void Evaluator::tangents(double t, const double* x, int nd, ConstDirView dx, bool with_params,
+                         DirView dxdot, DirView dqdot) {
+  outputs(t, x);
+  const int ld = d_.num_signals;
+  dsig_.resize(static_cast<size_t>(ld) * nd);
+  for (size_t i = 0; i < d_.nodes.size(); ++i) {
+    const Node& n = d_.nodes[i];
+    const int idx = static_cast<int>(i);
+    const Eval e = eval_for(n, idx, t, x);
+    const Seeds s = seeds_for(n, idx, nd, dx, with_params);
+    for (size_t k = 0; k < n.output_offset.size(); ++k) dy_[k] = {dsig_.data() + n.output_offset[k], ld};
+    n.block->outputs_tangent(e, s, dy_.data());
+  }
+  for (size_t i = 0; i < d_.nodes.size(); ++i) {
+    const Node& n = d_.nodes[i];
+    const int idx = static_cast<int>(i);
+    if (dxdot.data && n.block->num_states() > 0)
+      n.block->derivatives_tangent(eval_for(n, idx, t, x), seeds_for(n, idx, nd, dx, with_params),
+                                   {dxdot.data + n.state_offset, dxdot.ld});
+    if (dqdot.data && n.block->num_quadratures() > 0)
+      n.block->quadratures_tangent(eval_for(n, idx, t, x), seeds_for(n, idx, nd, dx, with_params),
+                                   {dqdot.data + n.quad_offset, dqdot.ld});
+  }
+}
+
+std::string Evaluator::find_nonfinite(const double* xdot) const {
+  for (const Node& n : d_.nodes) {
+    const auto& ports = n.block->outputs();
+    for (size_t k = 0; k < ports.size(); ++k)
+      for (int c = 0; c < ports[k].width; ++c)
+        if (!std::isfinite(sig_[n.output_offset[k] + c]))
+          return n.name + ": output " + ports[k].name + " is not finite";
+    if (xdot)
+      for (int c = 0; c < n.block->num_states(); ++c)
+        if (!std::isfinite(xdot[n.state_offset + c]))
+          return n.name + ": derivative of state " + n.block->state_names()[c] + " is not finite";
+  }
+  return {};
+}
+
+}  // namespace dydp::engine

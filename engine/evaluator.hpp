@@ -1,0 +1,68 @@
+// The diagram's passes over its blocks in evaluation order: the value pass (outputs), state
+// derivatives and quadrature integrands, and the tangent pass (their forward derivatives for
+// many directions at once). Solvers call these; nothing here knows which solver runs.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "engine/diagram.hpp"
+
+namespace dydp::engine {
+
+class Evaluator {
+ public:
+  /// `directions`: the sensitivity directions whose parameter seeds the tangent pass applies
+  /// (the diagram's sensitivities, or none for a run without them).
+  Evaluator(const Diagram& d, bool with_sensitivities);
+
+  int num_directions() const { return ns_; }
+  void set_segment_start(double t) { segment_start_ = t; valid_ = false; }
+
+  /// x(t0) and, for the sensitivity directions, dx(t0)/dp (ld = num_states).
+  void initial_state(double t0, double* x0);
+  void initial_state_tangent(double t0, const double* x0, DirView dx0);
+
+  /// Value pass: every kept block's outputs at (t, x). Cached: repeated calls are free.
+  void outputs(double t, const double* x);
+  /// xdot = f(t, x) (runs the value pass if needed).
+  void derivatives(double t, const double* x, double* xdot);
+  /// Quadrature integrands at (t, x).
+  void quadratures(double t, const double* x, double* qdot);
+
+  /// Tangent pass for nd directions: state seeds dx (ld = num_states, null data: zero) and, when
+  /// with_params, the sensitivity parameter seeds (then nd must be num_directions()). Fills the
+  /// signal tangents and, where given, dxdot (ld = num_states) and dqdot (ld = num_quadratures).
+  void tangents(double t, const double* x, int nd, ConstDirView dx, bool with_params,
+                DirView dxdot, DirView dqdot);
+
+  const std::vector<double>& signals() const { return sig_; }
+  /// Signal tangents of the last tangent pass: element (i, d) at [d * num_signals + i].
+  const std::vector<double>& signal_tangents() const { return dsig_; }
+
+  /// Names the first block whose outputs or derivatives (xdot, may be null) are not finite;
+  /// empty when all are.
+  std::string find_nonfinite(const double* xdot) const;
+
+ private:
+  Eval eval_for(const Node& n, int index, double t, const double* x) const;
+  Seeds seeds_for(const Node& n, int index, int nd, ConstDirView dx, bool with_params);
+
+  const Diagram& d_;
+  int ns_ = 0;
+  double segment_start_ = 0.0;
+  std::vector<double> sig_, dsig_;
+  std::vector<double> pseed_;          ///< per node np x ns, d-major, concatenated
+  std::vector<int> pseed_offset_;
+  std::vector<const double*> u_;       ///< input pointers, per node concatenated
+  std::vector<int> u_offset_;
+  std::vector<double*> y_;             ///< output pointers, per node concatenated
+  std::vector<ConstDirView> du_;       ///< scratch for a node's input seed views
+  std::vector<DirView> dy_;            ///< scratch for a node's output seed views
+  std::vector<double> zero_x_;         ///< seeds for state-less evaluations
+  bool valid_ = false;
+  double last_t_ = 0.0;
+  std::vector<double> last_x_;
+};
+
+}  // namespace dydp::engine

@@ -1,0 +1,102 @@
+#include "engine/output_writer.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+namespace dydp::engine {
+
+void write_file_atomically(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error("cannot write " + tmp);
+    out << text;
+    out.flush();
+    if (!out) {
+      std::remove(tmp.c_str());
+      throw std::runtime_error("error while writing " + tmp);
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error("cannot rename " + tmp + " to " + path + ": " + ec.message());
+  }
+}
+
+std::string signals_csv(const RunResult& r) {
+  std::ostringstream out;
+  out.precision(12);
+  const int nsig = r.num_signals();
+  const int ns = static_cast<int>(r.sensitivity_names.size());
+  out << "t";
+  for (const auto& s : r.signal_names) out << ',' << s;
+  for (const auto& p : r.sensitivity_names)
+    for (const auto& s : r.signal_names) out << ",d(" << s << ")/d(" << p << ')';
+  out << '\n';
+  for (size_t k = 0; k < r.t.size(); ++k) {
+    out << r.t[k];
+    for (int i = 0; i < nsig; ++i) out << ',' << r.value(static_cast<int>(k), i);
+    for (int d = 0; d < ns; ++d)
+      for (int i = 0; i < nsig; ++i) out << ',' << r.tangent(static_cast<int>(k), d, i);
+    out << '\n';
+  }
+  return out.str();
+}
+
+std::string objectives_json(const RunResult& r) {
+  nlohmann::ordered_json objectives = nlohmann::ordered_json::object();
+  for (const auto& o : r.objectives) {
+    nlohmann::ordered_json sens = nlohmann::ordered_json::object();
+    for (size_t d = 0; d < r.sensitivity_names.size(); ++d) sens[r.sensitivity_names[d]] = o.sensitivity[d];
+    objectives[o.name] = {{"value", o.value}, {"sensitivity", sens}};
+  }
+  return nlohmann::ordered_json{{"objectives", objectives}}.dump(2) + "\n";
+}
+
+std::string run_json(const Diagram& d, const RunResult& r) {
+  const RunStats& s = r.stats;
+  nlohmann::ordered_json parameters = nlohmann::ordered_json::object();
+  for (const auto& p : d.parameters) parameters[p.name] = {{"value", p.value}, {"unit", p.unit}};
+  nlohmann::ordered_json j = {
+      {"scene", d.scene_name},
+      {"file", d.file},
+      {"solver", s.method},
+      {"rtol", s.rtol},
+      {"atol", s.atol},
+      {"fixed_step", s.step},
+      {"parameters", parameters},
+      {"sensitivities", r.sensitivity_names},
+      {"states", d.num_states},
+      {"steps", s.steps},
+      {"rhs_evaluations", s.rhs_evals},
+      {"sensitivity_rhs_evaluations", s.sens_rhs_evals},
+      {"jacobian_evaluations", s.jac_evals},
+      {"error_test_failures", s.error_test_failures},
+      {"nonlinear_iterations", s.nonlinear_iterations},
+      {"cpu_seconds", s.cpu_seconds},
+      {"simulated_seconds", s.simulated_seconds},
+      {"realtime_factor", s.realtime_factor},
+      {"pruned_blocks", d.pruned},
+      {"warnings", s.warnings},
+  };
+  return j.dump(2) + "\n";
+}
+
+void write_outputs(const std::string& dir, const Diagram& d, const RunResult& r) {
+  std::filesystem::create_directories(dir);
+  // Compose everything first so that a failure leaves no half-written set behind.
+  const std::string signals = signals_csv(r), objectives = objectives_json(r), run = run_json(d, r);
+  write_file_atomically(dir + "/signals.csv", signals);
+  write_file_atomically(dir + "/objectives.json", objectives);
+  write_file_atomically(dir + "/run.json", run);
+}
+
+}  // namespace dydp::engine

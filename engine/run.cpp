@@ -1,0 +1,19 @@
+#include "engine/run.hpp"
+
+#include "engine/cvodes_solver.hpp"
+#include "engine/rk4_solver.hpp"
+
+namespace dydp::engine {
+
+int RunResult::signal_index(const std::string& name) const {
+  for (size_t i = 0; i < signal_names.size(); ++i)
+    if (signal_names[i] == name) return static_cast<int>(i);
+  return -1;
+}
+
+RunResult run(const Diagram& d, const RunOptions& options) {
+  if (d.solver.method == "rk4") return run_rk4(d, options);
+  return run_cvodes(d, options);
+}
+
+}  // namespace dydp::engine

@@ -1,0 +1,60 @@
+// Running a diagram: options, the recorded results (signals and their sensitivities on the
+// output grid, objectives with d(psi)/dp) and the run statistics that go to run.json.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "engine/diagram.hpp"
+
+namespace dydp::engine {
+
+struct RunOptions {
+  bool sensitivities = true;                  ///< false: --no-sens, no tangent work at all
+  std::function<void(double t)> progress;     ///< called at every output time
+};
+
+struct RunStats {
+  std::string method;
+  double rtol = 0.0, atol = 0.0, step = 0.0;
+  long steps = 0;
+  long rhs_evals = 0;             ///< value passes for state derivatives
+  long sens_rhs_evals = 0;        ///< tangent passes for the sensitivity equations
+  long jac_evals = 0;             ///< Jacobians (each one tangent pass over all states)
+  long error_test_failures = 0;
+  long nonlinear_iterations = 0;
+  double cpu_seconds = 0.0;
+  double simulated_seconds = 0.0;
+  double realtime_factor = 0.0;   ///< simulated seconds per CPU second
+  std::vector<std::string> warnings;
+};
+
+struct ObjectiveResult {
+  std::string name;
+  double value = 0.0;
+  std::vector<double> sensitivity;  ///< one per sensitivity direction
+};
+
+struct RunResult {
+  std::vector<std::string> signal_names;       ///< logged scalars
+  std::vector<std::string> sensitivity_names;  ///< the directions (empty without sensitivities)
+  std::vector<double> t;                       ///< output grid
+  std::vector<double> values;                  ///< values[k * nsig + i]
+  std::vector<double> tangents;                ///< tangents[(k * ns + d) * nsig + i]
+  std::vector<double> final_state;
+  std::vector<ObjectiveResult> objectives;
+  RunStats stats;
+
+  int num_signals() const { return static_cast<int>(signal_names.size()); }
+  double value(int k, int i) const { return values[k * num_signals() + i]; }
+  double tangent(int k, int d, int i) const {
+    return tangents[(k * static_cast<int>(sensitivity_names.size()) + d) * num_signals() + i];
+  }
+  int signal_index(const std::string& name) const;
+};
+
+/// Runs the diagram with the method of its solver spec. Throws SolverError on failure.
+RunResult run(const Diagram& d, const RunOptions& options = {});
+
+}  // namespace dydp::engine
