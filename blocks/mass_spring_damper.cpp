@@ -17,8 +17,8 @@ class MassSpringDamper : public Block {
   enum { kMass, kStiffness, kDamping, kX0, kV0 };
   MassSpringDamper() {
     declare_input("f", 1, "N");
-    declare_output("x", 1, "m");
-    declare_output("v", 1, "m/s");
+    declare_output("x", 1, "m", false);
+    declare_output("v", 1, "m/s", false);
     declare_output("a", 1, "m/s^2");
     declare_states({"x", "v"});
   }
@@ -47,13 +47,13 @@ class MassSpringDamper : public Block {
   void outputs(const Eval& e, double* const* y) const override {
     y[0][0] = e.x[0];
     y[1][0] = e.x[1];
-    y[2][0] = acceleration(e);
+    if (e.inputs_ready) y[2][0] = acceleration(e);
   }
   void outputs_tangent(const Eval& e, const Seeds& s, const DirView* dy) const override {
     for (int d = 0; d < s.directions; ++d) {
       dy[0](0, d) = s.x(0, d);
       dy[1](0, d) = s.x(1, d);
-      dy[2](0, d) = acceleration_tangent(e, s, d);
+      if (e.inputs_ready) dy[2](0, d) = acceleration_tangent(e, s, d);
     }
   }
   void derivatives(const Eval& e, double* xdot) const override {

@@ -96,7 +96,7 @@ class Integrator : public Block {
  public:
   explicit Integrator(int width) : w_(width) {
     declare_input("u", w_, "", false);
-    declare_output("y", w_);
+    declare_output("y", w_, "", false);
     std::vector<std::string> names;
     for (int i = 0; i < w_; ++i) names.push_back(w_ == 1 ? "x" : "x" + std::to_string(i));
     declare_states(names);

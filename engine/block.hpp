@@ -29,7 +29,9 @@ struct PortDecl {
   std::string name;
   int width = 1;
   std::string unit;
-  /// Inputs only: true when some output depends on this input without a state in between.
+  /// Input: some output reads this input directly (without a state in between).
+  /// Output: this output reads some input directly. Algebraic loops are cycles through such
+  /// input -> output pairs; an output that reads states only breaks the cycle.
   bool feedthrough = true;
 };
 
@@ -42,7 +44,9 @@ struct Eval {
   const double* x = nullptr;          ///< the block's states [num_states]
   const double* const* u = nullptr;   ///< u[k]: input port k, [width of port k]
   const double* p = nullptr;          ///< parameter values, in the order of the block's ParamSpecs
-  const double* q = nullptr;          ///< quadratures so far (objectives only)
+  /// False in the first output pass, where only outputs declared without feedthrough need be
+  /// computed and inputs must not be read (they are not yet computed for this point).
+  bool inputs_ready = true;
 
   /// Whether time has passed the breakpoint tb: true after it, and at it when the current
   /// segment started there.
@@ -78,6 +82,8 @@ class Block {
   virtual void initial_state_tangent(const Eval& e, const Seeds& s, DirView dx0) const {}
 
   /// y = g(t, x, u, p) for every output port: y[k] has the width of output port k.
+  /// A block with outputs of both kinds is called twice per point: first with
+  /// e.inputs_ready == false (set the state-only outputs), then with all inputs ready.
   virtual void outputs(const Eval& e, double* const* y) const = 0;
   /// dy = g_x dx + g_u du + g_p dp, for every output port and direction.
   virtual void outputs_tangent(const Eval& e, const Seeds& s, const DirView* dy) const = 0;
@@ -98,8 +104,8 @@ class Block {
   void declare_input(std::string name, int width, std::string unit = "", bool feedthrough = true) {
     inputs_.push_back({std::move(name), width, std::move(unit), feedthrough});
   }
-  void declare_output(std::string name, int width, std::string unit = "") {
-    outputs_.push_back({std::move(name), width, std::move(unit), true});
+  void declare_output(std::string name, int width, std::string unit = "", bool feedthrough = true) {
+    outputs_.push_back({std::move(name), width, std::move(unit), feedthrough});
   }
   void declare_states(std::vector<std::string> names) {
     num_states_ = static_cast<int>(names.size());

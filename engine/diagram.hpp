@@ -67,7 +67,10 @@ class Diagram {
   SolverSpec solver;
   std::vector<SceneParameter> parameters;
   std::vector<int> sensitivities;      ///< indices into parameters: the directions
-  std::vector<Node> nodes;             ///< kept blocks, in evaluation order
+  std::vector<Node> nodes;             ///< kept blocks, in scene order
+  /// Output evaluation: first the blocks with state-only outputs (inputs not ready), then, in
+  /// dependency order, the blocks with feedthrough outputs (a block may be in both).
+  std::vector<int> first_pass, second_pass;
   std::vector<std::string> pruned;     ///< blocks no requested output needs
   std::vector<LoggedSignal> logged;    ///< one entry per scalar logged
   std::vector<int> objectives;         ///< node indices of requested objectives

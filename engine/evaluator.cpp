@@ -77,11 +77,14 @@ void Evaluator::outputs(double t, const double* x) {
   const int nx = d_.num_states;
   if (valid_ && t == last_t_ && (nx == 0 || std::memcmp(x, last_x_.data(), nx * sizeof(double)) == 0))
     return;
-  for (size_t i = 0; i < d_.nodes.size(); ++i) {
-    const Node& n = d_.nodes[i];
-    for (size_t k = 0; k < n.output_offset.size(); ++k) y_[k] = sig_.data() + n.output_offset[k];
-    n.block->outputs(eval_for(n, static_cast<int>(i), t, x), y_.data());
-  }
+  for (int pass = 0; pass < 2; ++pass)
+    for (int i : pass == 0 ? d_.first_pass : d_.second_pass) {
+      const Node& n = d_.nodes[i];
+      for (size_t k = 0; k < n.output_offset.size(); ++k) y_[k] = sig_.data() + n.output_offset[k];
+      Eval e = eval_for(n, i, t, x);
+      e.inputs_ready = pass == 1;
+      n.block->outputs(e, y_.data());
+    }
   valid_ = true;
   last_t_ = t;
   if (nx) std::memcpy(last_x_.data(), x, nx * sizeof(double));
@@ -110,14 +113,15 @@ void Evaluator::tangents(double t, const double* x, int nd, ConstDirView dx, boo
   outputs(t, x);
   const int ld = d_.num_signals;
   dsig_.resize(static_cast<size_t>(ld) * nd);
-  for (size_t i = 0; i < d_.nodes.size(); ++i) {
-    const Node& n = d_.nodes[i];
-    const int idx = static_cast<int>(i);
-    const Eval e = eval_for(n, idx, t, x);
-    const Seeds s = seeds_for(n, idx, nd, dx, with_params);
-    for (size_t k = 0; k < n.output_offset.size(); ++k) dy_[k] = {dsig_.data() + n.output_offset[k], ld};
-    n.block->outputs_tangent(e, s, dy_.data());
-  }
+  for (int pass = 0; pass < 2; ++pass)
+    for (int i : pass == 0 ? d_.first_pass : d_.second_pass) {
+      const Node& n = d_.nodes[i];
+      Eval e = eval_for(n, i, t, x);
+      e.inputs_ready = pass == 1;
+      const Seeds s = seeds_for(n, i, nd, dx, with_params);
+      for (size_t k = 0; k < n.output_offset.size(); ++k) dy_[k] = {dsig_.data() + n.output_offset[k], ld};
+      n.block->outputs_tangent(e, s, dy_.data());
+    }
   for (size_t i = 0; i < d_.nodes.size(); ++i) {
     const Node& n = d_.nodes[i];
     const int idx = static_cast<int>(i);

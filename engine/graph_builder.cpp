@@ -70,20 +70,30 @@ void GraphBuilder::request_output(const std::string& text, int line) {
   requested_.emplace_back(resolve(trim(text), false, line), line);
 }
 
+bool GraphBuilder::has_feedthrough_output(int node) const {
+  const auto& outs = nodes_[node].block->outputs();
+  return std::any_of(outs.begin(), outs.end(), [](const PortDecl& p) { return p.feedthrough; });
+}
+
 std::vector<int> GraphBuilder::order_or_report_loop(const std::vector<bool>& keep) const {
-  // Kahn's algorithm on direct-feedthrough edges; ties keep the scene's order.
+  // Kahn's algorithm over the blocks' feedthrough outputs: block t waits for block s when an
+  // output of s that reads inputs drives an input of t that some output of t reads. Outputs
+  // that read states only are computed first, in a pass of their own. Ties keep scene order.
   const int n = static_cast<int>(nodes_.size());
+  std::vector<bool> late(n, false);
+  for (int i = 0; i < n; ++i) late[i] = keep[i] && has_feedthrough_output(i);
   std::vector<int> indegree(n, 0);
   std::vector<std::vector<int>> next(n);
   for (const Edge& e : edges_) {
-    if (!keep[e.src.node] || !keep[e.dst.node]) continue;
+    if (!late[e.src.node] || !late[e.dst.node]) continue;
+    if (!nodes_[e.src.node].block->outputs()[e.src.port].feedthrough) continue;
     if (!nodes_[e.dst.node].block->inputs()[e.dst.port].feedthrough) continue;
     next[e.src.node].push_back(e.dst.node);
     ++indegree[e.dst.node];
   }
   std::priority_queue<int, std::vector<int>, std::greater<int>> ready;
   for (int i = 0; i < n; ++i)
-    if (keep[i] && indegree[i] == 0) ready.push(i);
+    if (late[i] && indegree[i] == 0) ready.push(i);
   std::vector<int> order;
   while (!ready.empty()) {
     const int i = ready.top();
@@ -92,8 +102,8 @@ std::vector<int> GraphBuilder::order_or_report_loop(const std::vector<bool>& kee
     for (int j : next[i])
       if (--indegree[j] == 0) ready.push(j);
   }
-  const int kept = static_cast<int>(std::count(keep.begin(), keep.end(), true));
-  if (static_cast<int>(order.size()) == kept) return order;
+  const int count = static_cast<int>(std::count(late.begin(), late.end(), true));
+  if (static_cast<int>(order.size()) == count) return order;
 
   // Some blocks remain, each with a remaining predecessor: walk predecessors until one repeats.
   std::vector<std::vector<int>> prev(n);
@@ -101,7 +111,7 @@ std::vector<int> GraphBuilder::order_or_report_loop(const std::vector<bool>& kee
     for (int j : next[i]) prev[j].push_back(i);
   int at = -1;
   for (int i = 0; i < n && at < 0; ++i)
-    if (keep[i] && indegree[i] > 0) at = i;
+    if (late[i] && indegree[i] > 0) at = i;
   std::vector<int> path;
   std::vector<int> pos(n, -1);
   while (pos[at] < 0) {
@@ -154,14 +164,15 @@ void GraphBuilder::build(Diagram& d) {
   }
   // Loops are errors even in pruned parts of the scene: check over all blocks first.
   order_or_report_loop(std::vector<bool>(n, true));
-  const std::vector<int> order = order_or_report_loop(keep);
+  const std::vector<int> second = order_or_report_loop(keep);
 
   for (int i = 0; i < n; ++i)
     if (!keep[i]) d.pruned.push_back(nodes_[i].name);
 
-  // Lay out signals, states and quadratures in evaluation order.
+  // Lay out signals, states and quadratures in scene order.
   std::vector<int> new_index(n, -1);
-  for (int i : order) {
+  for (int i = 0; i < n; ++i) {
+    if (!keep[i]) continue;
     Node& node = nodes_[i];
     node.state_offset = d.num_states;
     d.num_states += node.block->num_states();
@@ -173,8 +184,12 @@ void GraphBuilder::build(Diagram& d) {
     }
     node.input_source.assign(node.block->inputs().size(), -1);
     new_index[i] = static_cast<int>(d.nodes.size());
+    const auto& outs = node.block->outputs();
+    if (std::any_of(outs.begin(), outs.end(), [](const PortDecl& p) { return !p.feedthrough; }))
+      d.first_pass.push_back(new_index[i]);
     d.nodes.push_back(std::move(node));
   }
+  for (int i : second) d.second_pass.push_back(new_index[i]);
   for (const Edge& e : edges_) {
     if (new_index[e.dst.node] < 0) continue;
     Node& dst = d.nodes[new_index[e.dst.node]];
