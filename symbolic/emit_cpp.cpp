@@ -1,0 +1,409 @@
+// Writing equation lists as C++: an expression printer with minimal parentheses, and the
+// function and file layouts documented in emit_cpp.hpp.
+#include "symbolic/emit_cpp.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+
+#include "symbolic/op_count.hpp"
+
+namespace dydp::symbolic {
+namespace {
+
+// Binding strength of what a node prints as: 0 sum, 1 product or quotient, 2 unary minus, 3 atom.
+int precedence(const Context& ctx, NodeId n) {
+  switch (ctx.op(n)) {
+    case Op::Constant: return ctx.value(n) < 0.0 ? 2 : 3;
+    case Op::Symbol: return 3;
+    case Op::Add: return 0;
+    case Op::Mul:
+    case Op::Div: return 1;
+    case Op::Neg: return 2;
+    case Op::Pow: {
+      const NodeId e = ctx.children(n)[1];
+      if (ctx.op(e) == Op::Constant) {
+        const double v = ctx.value(e);
+        if (v == std::nearbyint(v) && std::fabs(v) <= kMaxInlinePower) return 1;
+      }
+      return 3;
+    }
+    default: return 3;
+  }
+}
+
+// Shortest decimal that reads back as the same double, always with a '.' or an exponent.
+std::string number(double v) {
+  if (std::isnan(v)) return "std::numeric_limits<double>::quiet_NaN()";
+  if (std::isinf(v)) return v > 0 ? "std::numeric_limits<double>::infinity()"
+                                   : "(-std::numeric_limits<double>::infinity())";
+  char buffer[40];
+  for (int digits = 15; digits <= 17; ++digits) {
+    std::snprintf(buffer, sizeof buffer, "%.*g", digits, v);
+    if (std::strtod(buffer, nullptr) == v) break;
+  }
+  std::string s = buffer;
+  if (s.find_first_of(".en") == std::string::npos) s += ".0";
+  return s;
+}
+
+bool small_integer_power(const Context& ctx, NodeId n, int* exponent) {
+  if (ctx.op(n) != Op::Pow || ctx.op(ctx.children(n)[1]) != Op::Constant) return false;
+  const double v = ctx.value(ctx.children(n)[1]);
+  if (v != std::nearbyint(v) || std::fabs(v) > kMaxInlinePower) return false;
+  *exponent = static_cast<int>(v);
+  return true;
+}
+
+class Printer {
+ public:
+  explicit Printer(const Context& ctx) : ctx_(ctx) {}
+
+  void print(NodeId n, std::string& out) const {
+    switch (ctx_.op(n)) {
+      case Op::Constant: {
+        const double v = ctx_.value(n);
+        if (v < 0.0) out += '-';
+        out += number(std::fabs(v));
+        return;
+      }
+      case Op::Symbol: {
+        const Symbol& s = ctx_.symbol(n);
+        if (s.kind == SymbolKind::Aux) out += s.name;
+        else out += ctx_.array(s.array).name + "[" + std::to_string(s.index) + "]";
+        return;
+      }
+      case Op::Add: {
+        bool first = true;
+        for (NodeId t : ctx_.children(n)) {
+          if (first) print(t, out);
+          else print_term(t, out);
+          first = false;
+        }
+        return;
+      }
+      case Op::Mul: print_product(n, false, out); return;
+      case Op::Neg:
+        out += "-";
+        wrapped(ctx_.children(n)[0], 2, out);
+        return;
+      case Op::Div:
+        wrapped(ctx_.children(n)[0], 1, out);
+        out += "/";
+        wrapped(ctx_.children(n)[1], 3, out);
+        return;
+      case Op::Pow: {
+        int e = 0;
+        if (small_integer_power(ctx_, n, &e)) {
+          if (e < 0) {
+            out += "1.0/";
+            if (e == -1) wrapped(ctx_.children(n)[0], 3, out);
+            else {
+              out += "(";
+              repeated(ctx_.children(n)[0], -e, out);
+              out += ")";
+            }
+          } else {
+            repeated(ctx_.children(n)[0], e, out);
+          }
+          return;
+        }
+        call("std::pow", n, out);
+        return;
+      }
+      case Op::Sin:
+      case Op::Cos:
+        if (ctx_.is_abbreviation(n)) {
+          out += ctx_.abbreviation_name(n);
+          return;
+        }
+        call(ctx_.op(n) == Op::Sin ? "std::sin" : "std::cos", n, out);
+        return;
+      case Op::Tan: call("std::tan", n, out); return;
+      case Op::Atan2: call("std::atan2", n, out); return;
+      case Op::Sqrt: call("std::sqrt", n, out); return;
+      case Op::Exp: call("std::exp", n, out); return;
+      case Op::Log: call("std::log", n, out); return;
+      case Op::Abs: call("std::fabs", n, out); return;
+      case Op::Min: call("std::fmin", n, out); return;
+      case Op::Max: call("std::fmax", n, out); return;
+      case Op::Sign: {
+        std::string x;
+        wrapped(ctx_.children(n)[0], 3, x);
+        out += "(" + x + " > 0.0 ? 1.0 : (" + x + " < 0.0 ? -1.0 : 0.0))";
+        return;
+      }
+      case Op::Select: {
+        auto k = ctx_.children(n);
+        out += "(";
+        wrapped(k[0], 1, out);
+        out += " > 0.0 ? ";
+        print(k[1], out);
+        out += " : ";
+        print(k[2], out);
+        out += ")";
+        return;
+      }
+    }
+  }
+
+ private:
+  void wrapped(NodeId n, int needed, std::string& out) const {
+    if (precedence(ctx_, n) >= needed) {
+      print(n, out);
+    } else {
+      out += "(";
+      print(n, out);
+      out += ")";
+    }
+  }
+
+  void repeated(NodeId base, int times, std::string& out) const {
+    for (int i = 0; i < times; ++i) {
+      if (i) out += "*";
+      wrapped(base, 3, out);
+    }
+  }
+
+  void call(const char* function, NodeId n, std::string& out) const {
+    out += function;
+    out += "(";
+    bool first = true;
+    for (NodeId c : ctx_.children(n)) {
+      if (!first) out += ", ";
+      print(c, out);
+      first = false;
+    }
+    out += ")";
+  }
+
+  // A term after the first of a sum: written as a subtraction when it is negative.
+  void print_term(NodeId t, std::string& out) const {
+    switch (ctx_.op(t)) {
+      case Op::Neg:
+        out += " - ";
+        wrapped(ctx_.children(t)[0], 1, out);
+        return;
+      case Op::Constant:
+        if (ctx_.value(t) < 0.0) {
+          out += " - ";
+          out += number(-ctx_.value(t));
+          return;
+        }
+        break;
+      case Op::Mul: {
+        const NodeId c = ctx_.children(t)[0];
+        if (ctx_.op(c) == Op::Constant && ctx_.value(c) < 0.0) {
+          out += " - ";
+          print_product(t, true, out);
+          return;
+        }
+        break;
+      }
+      default: break;
+    }
+    out += " + ";
+    wrapped(t, 1, out);
+  }
+
+  // c * f1 * f2 / (g1 * g2), the g being the factors with negative integer powers.
+  void print_product(NodeId n, bool negate_coefficient, std::string& out) const {
+    std::string numerator, denominator;
+    int denominator_factors = 0;
+    for (NodeId f : ctx_.children(n)) {
+      int e = 0;
+      if (ctx_.op(f) == Op::Constant) {
+        const double c = negate_coefficient ? -ctx_.value(f) : ctx_.value(f);
+        if (!numerator.empty()) numerator += "*";
+        if (c < 0.0) numerator += '-';
+        numerator += number(std::fabs(c));
+      } else if (small_integer_power(ctx_, f, &e) && e < 0) {
+        if (!denominator.empty()) denominator += "*";
+        repeated(ctx_.children(f)[0], -e, denominator);
+        denominator_factors += -e;
+      } else {
+        if (!numerator.empty()) numerator += "*";
+        wrapped(f, 2, numerator);
+      }
+    }
+    out += numerator.empty() ? "1.0" : numerator;
+    if (denominator_factors == 1) out += "/" + denominator;
+    else if (denominator_factors > 1) out += "/(" + denominator + ")";
+  }
+
+  const Context& ctx_;
+};
+
+std::string one_line(std::string s) {
+  for (char& c : s) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  return s;
+}
+
+// Abbreviations (S3, C3) the list reads, in node order.
+std::vector<NodeId> abbreviations_used(const EquationList& list) {
+  const Context& ctx = list.context();
+  std::vector<char> seen(ctx.size(), 0);
+  std::vector<NodeId> stack, found;
+  auto walk = [&](NodeId root) {
+    stack.push_back(root);
+    while (!stack.empty()) {
+      const NodeId n = stack.back();
+      stack.pop_back();
+      if (seen[n]) continue;
+      seen[n] = 1;
+      if (ctx.is_abbreviation(n)) {
+        found.push_back(n);
+        continue;
+      }
+      for (NodeId c : ctx.children(n)) stack.push_back(c);
+    }
+  };
+  for (const Assignment& a : list.assignments()) walk(a.value);
+  for (const Output& o : list.outputs()) walk(o.value);
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+void check_size(const EquationList& list, const EmitOptions& options) {
+  const OpCount ops = count_ops(list);
+  if (ops.total() > options.max_ops) {
+    throw std::length_error("symbolic: " + options.function_name + " would be written with " +
+                            std::to_string(ops.total()) + " operations (limit " +
+                            std::to_string(options.max_ops) + ")");
+  }
+}
+
+std::string input_parameters(const Context& ctx) {
+  std::string s;
+  for (ArrayId a = 0; a < ctx.array_count(); ++a) {
+    if (ctx.array(a).kind == SymbolKind::Seed) continue;
+    s += "[[maybe_unused]] const double* " + ctx.array(a).name + ", ";
+  }
+  return s;
+}
+
+std::string linkage(const EmitOptions& options) { return options.extern_c ? "extern \"C\" " : ""; }
+
+std::string summary(const EquationList& list, const std::string& name) {
+  const OpCount ops = count_ops(list);
+  return "// " + name + ": " + std::to_string(list.size()) + " assignments; " +
+         std::to_string(ops.add) + " add, " + std::to_string(ops.mul) + " mul, " +
+         std::to_string(ops.div) + " div, " + std::to_string(ops.call) + " call\n";
+}
+
+void write_prologue(const EquationList& list, const Printer& printer, std::string& body) {
+  const Context& ctx = list.context();
+  for (NodeId n : abbreviations_used(list)) {
+    const NodeId x = ctx.children(n)[0];
+    body += "  const double " + ctx.abbreviation_name(n) + " = " +
+            (ctx.op(n) == Op::Sin ? "std::sin(" : "std::cos(");
+    printer.print(x, body);
+    body += ");\n";
+  }
+}
+
+void write_assignments(const EquationList& list, const Printer& printer, std::size_t begin,
+                       std::size_t end, const std::string& indent, std::string& body) {
+  const Context& ctx = list.context();
+  for (std::size_t i = begin; i < end; ++i) {
+    const Assignment& a = list.assignments()[i];
+    body += indent + "const double " + ctx.symbol(a.target).name + " = ";
+    printer.print(a.value, body);
+    body += ";\n";
+  }
+}
+
+}  // namespace
+
+std::string to_cpp(const Context& context, NodeId expression) {
+  std::string s;
+  Printer(context).print(expression, s);
+  return s;
+}
+
+EmittedFunction emit_function(const EquationList& list, const EmitOptions& options) {
+  check_size(list, options);
+  const Context& ctx = list.context();
+  const Printer printer(ctx);
+  const std::string signature = linkage(options) + "void " + options.function_name + "(" +
+                                input_parameters(ctx) + "double* out) noexcept";
+  std::string body = summary(list, options.function_name) + signature + "\n{\n";
+  write_prologue(list, printer, body);
+  write_assignments(list, printer, 0, list.size(), "  ", body);
+  for (std::size_t j = 0; j < list.outputs().size(); ++j) {
+    const Output& o = list.outputs()[j];
+    body += "  out[" + std::to_string(j) + "] = ";
+    printer.print(o.value, body);
+    body += ";  // " + one_line(o.name) + "\n";
+  }
+  body += "}\n";
+  return EmittedFunction{options.function_name, signature + ";\n", body};
+}
+
+EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayId> seeded_arrays,
+                             const EmitOptions& options) {
+  if (!tangent.has_split()) throw std::invalid_argument("symbolic: emit_tangent needs a list from tangent_list");
+  check_size(tangent, options);
+  Context& ctx = tangent.context();
+  const Printer printer(ctx);
+  std::string seeds;
+  for (ArrayId a : seeded_arrays) seeds += "const double* seed_" + ctx.array(a).name + ", ";
+  const std::string signature = linkage(options) + "void " + options.function_name + "(" +
+                                input_parameters(ctx) + "int nd, " + seeds +
+                                "double* out, double* dout) noexcept";
+  const std::size_t primal_outputs = tangent.primal_outputs();
+  const std::size_t derivative_outputs = tangent.outputs().size() - primal_outputs;
+  std::string body = summary(tangent, options.function_name) +
+                     "// primal once, then the derivative part once per direction d < nd;\n"
+                     "// seed (i, d) at seed_x[d*n + i], derivative (j, d) at dout[d*" +
+                     std::to_string(derivative_outputs) + " + j]\n" + signature + "\n{\n";
+  write_prologue(tangent, printer, body);
+  write_assignments(tangent, printer, 0, tangent.primal_assignments(), "  ", body);
+  for (std::size_t j = 0; j < primal_outputs; ++j) {
+    const Output& o = tangent.outputs()[j];
+    body += "  out[" + std::to_string(j) + "] = ";
+    printer.print(o.value, body);
+    body += ";  // " + one_line(o.name) + "\n";
+  }
+  body += "  for (int d = 0; d < nd; ++d) {\n";
+  for (ArrayId a : seeded_arrays) {
+    const Array& seed = ctx.array(ctx.seed_array(a));
+    body += "    [[maybe_unused]] const double* " + seed.name + " = seed_" + ctx.array(a).name +
+            " + d*" + std::to_string(seed.elements.size()) + ";\n";
+  }
+  write_assignments(tangent, printer, tangent.primal_assignments(), tangent.size(), "    ", body);
+  for (std::size_t j = 0; j < derivative_outputs; ++j) {
+    const Output& o = tangent.outputs()[primal_outputs + j];
+    body += "    dout[d*" + std::to_string(derivative_outputs) + " + " + std::to_string(j) + "] = ";
+    printer.print(o.value, body);
+    body += ";  // " + one_line(o.name) + "\n";
+  }
+  body += "  }\n}\n";
+  return EmittedFunction{options.function_name, signature + ";\n", body};
+}
+
+std::string emit_header_file(std::span<const EmittedFunction> functions, const EmitOptions& options) {
+  std::string s = "// Generated by dydp-gen; do not edit.\n// Source: " + one_line(options.origin) +
+                  "\n#pragma once\n\n";
+  if (!options.namespace_name.empty()) s += "namespace " + options.namespace_name + " {\n\n";
+  for (const EmittedFunction& f : functions) s += f.declaration;
+  if (!options.namespace_name.empty()) s += "\n}  // namespace " + options.namespace_name + "\n";
+  return s;
+}
+
+std::string emit_source_file(std::span<const EmittedFunction> functions, const std::string& header_name,
+                             const EmitOptions& options) {
+  std::string s = "// Generated by dydp-gen; do not edit.\n// Source: " + one_line(options.origin) +
+                  "\n";
+  if (!header_name.empty()) s += "#include \"" + header_name + "\"\n\n";
+  s += "#include <cmath>\n#include <limits>\n\n";
+  if (!options.namespace_name.empty()) s += "namespace " + options.namespace_name + " {\n\n";
+  for (const EmittedFunction& f : functions) s += f.definition + "\n";
+  if (!options.namespace_name.empty()) s += "}  // namespace " + options.namespace_name + "\n";
+  return s;
+}
+
+}  // namespace dydp::symbolic
