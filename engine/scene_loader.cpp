@@ -61,8 +61,11 @@ void read_time(const SceneReader& r, const YAML::Node& n, TimeSpec& time) {
   if (n["start"]) time.start = r.number(n["start"], "time.start");
   if (n["stop"]) time.stop = r.number(n["stop"], "time.stop");
   if (n["output_step"]) time.output_step = r.number(n["output_step"], "time.output_step");
-  if (!(time.stop > time.start)) r.fail(n, "time.stop", "must be greater than time.start");
-  if (!(time.output_step > 0)) r.fail(n, "time.output_step", "must be positive");
+  // Name the line of the offending value when it was written, else the line of `time:`.
+  if (!(time.stop > time.start))
+    r.fail(n["stop"] ? n["stop"] : n, "time.stop", "must be greater than time.start");
+  if (!(time.output_step > 0))
+    r.fail(n["output_step"] ? n["output_step"] : n, "time.output_step", "must be positive");
 }
 
 void read_solver(const SceneReader& r, const YAML::Node& n, SolverSpec& s) {
@@ -287,7 +290,8 @@ void Diagram::set_parameter(int index, double value) {
   if (value < sp.lower || value > sp.upper)
     throw InputError(file, sp.line, "parameters." + sp.name,
                      "value " + std::to_string(value) + " outside its range");
-  for (Node& n : nodes)
+  // Check every block parameter it drives before changing any: a refused value leaves none behind.
+  for (const Node& n : nodes)
     for (size_t j = 0; j < n.p.size(); ++j)
       if (n.p_scene[j] == index) {
         const ParamSpec& s = n.type->parameters[j];
@@ -295,8 +299,10 @@ void Diagram::set_parameter(int index, double value) {
           throw InputError(file, n.p_line[j], n.name + "." + s.name,
                            "value " + std::to_string(value) + " (from $" + sp.name +
                                ") outside its bounds");
-        n.p[j] = value;
       }
+  for (Node& n : nodes)
+    for (size_t j = 0; j < n.p.size(); ++j)
+      if (n.p_scene[j] == index) n.p[j] = value;
   sp.value = value;
 }
 

@@ -1,0 +1,428 @@
+// End-to-end tests of the dydp program: exit statuses (0 ok, 2 bad input, 1 solver failure),
+// `file:line:` messages on stderr, and the output folder contract of DESIGN.md section 5
+// (signals.csv, objectives.json, run.json, written whole or not at all).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "engine/registry.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct Result {
+  int status = -1;
+  std::string out, err;
+};
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::vector<std::string> split(const std::string& text, char sep) {
+  std::vector<std::string> out;
+  std::string item;
+  std::istringstream in(text);
+  while (std::getline(in, item, sep)) out.push_back(item);
+  return out;
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("dydp_cli_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  /// Runs `dydp ARGS` (ARGS already quoted), capturing stdout, stderr and the exit status.
+  Result dydp(const std::string& args) const {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = quote(DYDP_EXE) + " " + args + " >" + quote(out.string()) + " 2>" +
+                            quote(err.string());
+    const int raw = std::system(cmd.c_str());
+    Result r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = read_text(out);
+    r.err = read_text(err);
+    return r;
+  }
+
+  std::string write(const std::string& name, const std::string& text) const {
+    const fs::path p = dir_ / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p.string();
+  }
+
+  static std::string msd_scene() {
+    return (fs::path(DYDP_SOURCE_DIR) / "scenarios" / "msd_sensitivity.yaml").string();
+  }
+
+  /// Every entry of a folder (files and folders, hidden ones included).
+  static std::vector<std::string> entries(const fs::path& dir) {
+    std::vector<std::string> names;
+    if (!fs::exists(dir)) return names;
+    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    return names;
+  }
+
+  fs::path dir_;
+};
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += x + " ";
+  return s;
+}
+
+// ---------------------------------------------------------------- bad input: exit 2
+
+TEST_F(Cli, BadSceneExitsTwoWithFileLineAndWritesNothing) {
+  const std::string scene = write("bad.yaml", R"(scene: bad
+time: {stop: 1.0, output_step: 0.1}
+blocks:
+  src: {type: source.sine}
+  g: {type: math.gain, width: 2}
+connections:
+  - src.y -> g.u
+outputs: [g.y]
+)");
+  const fs::path out = dir_ / "out";
+  fs::create_directories(out);
+  const Result r = dydp("run " + quote(scene) + " --out " + quote(out.string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.rfind(scene + ":7: g.u: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("width mismatch"), std::string::npos) << r.err;
+  EXPECT_TRUE(entries(out).empty()) << "left in --out: " << join(entries(out));
+}
+
+TEST_F(Cli, BadSceneDoesNotCreateTheOutFolder) {
+  const std::string scene = write("bad.yaml", R"(scene: bad
+time: {stop: 1.0, output_step: 0.1}
+blocks:
+  src: {type: source.sinus}
+outputs: [src.y]
+)");
+  const fs::path out = dir_ / "never";
+  const Result r = dydp("run " + quote(scene) + " --out " + quote(out.string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.rfind(scene + ":4: src.type: ", 0), 0u) << r.err;
+  EXPECT_TRUE(entries(out).empty()) << "left in --out: " << join(entries(out));
+}
+
+struct BadScene {
+  const char* kind;
+  const char* yaml;
+  int line;
+  const char* field;
+};
+
+// The issue's validation errors, each through the program: exit 2, `file:line: field:` on
+// stderr, nothing in --out.
+const BadScene kBadScenes[] = {
+    {"unknown block type", "scene: t\nblocks:\n  a: {type: nope}\noutputs: [a.y]\n", 3, "a.type"},
+    {"unknown port",
+     "scene: t\nblocks:\n  a: {type: source.sine}\n  g: {type: math.gain}\nconnections:\n"
+     "  - a.y -> g.v\noutputs: [g.y]\n",
+     6, "g.v"},
+    {"width mismatch",
+     "scene: t\nblocks:\n  a: {type: source.sine}\n  g: {type: math.gain, width: 2}\nconnections:\n"
+     "  - a.y -> g.u\noutputs: [g.y]\n",
+     6, "g.u"},
+    {"unconnected input", "scene: t\nblocks:\n  a: {type: source.sine}\n  g: {type: math.gain}\noutputs: [a.y]\n",
+     4, "g.u"},
+    {"input driven twice",
+     "scene: t\nblocks:\n  a: {type: source.sine}\n  g: {type: math.gain}\nconnections:\n"
+     "  - a.y -> g.u\n  - a.y -> g.u\noutputs: [g.y]\n",
+     7, "g.u"},
+    {"algebraic loop",
+     "scene: t\nblocks:\n  g1: {type: math.gain}\n  g2: {type: math.gain}\nconnections:\n"
+     "  - g1.y -> g2.u\n  - g2.y -> g1.u\noutputs: [g1.y]\n",
+     6, "connections"},
+    {"unknown $parameter", "scene: t\nblocks:\n  a: {type: source.sine, amplitude: $amp}\noutputs: [a.y]\n", 3,
+     "a.amplitude"},
+    {"value out of bounds", "scene: t\nblocks:\n  a: {type: source.sine, frequency: -3}\noutputs: [a.y]\n", 3,
+     "a.frequency"},
+    {"malformed number", "scene: t\nblocks:\n  a: {type: source.sine, phase: 0..1}\noutputs: [a.y]\n", 3,
+     "a.phase"},
+};
+
+TEST_F(Cli, EachValidationErrorExitsTwoWithFileLineField) {
+  for (const BadScene& bad : kBadScenes) {
+    SCOPED_TRACE(bad.kind);
+    const std::string scene = write("bad.yaml", bad.yaml);
+    const fs::path out = dir_ / "out";
+    const Result r = dydp("run " + quote(scene) + " --out " + quote(out.string()));
+    EXPECT_EQ(r.status, 2) << r.err;
+    const std::string prefix = scene + ":" + std::to_string(bad.line) + ": " + bad.field + ": ";
+    EXPECT_EQ(r.err.rfind(prefix, 0), 0u) << "expected '" << prefix << "' in: " << r.err;
+    EXPECT_TRUE(entries(out).empty()) << "left in --out: " << join(entries(out));
+  }
+}
+
+TEST_F(Cli, SetUnknownParameterExitsTwo) {
+  const fs::path out = dir_ / "out";
+  const Result r = dydp("run " + quote(msd_scene()) + " --out " + quote(out.string()) +
+                        " --set massa=2.0");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("massa"), std::string::npos) << r.err;
+  EXPECT_TRUE(entries(out).empty()) << "left in --out: " << join(entries(out));
+}
+
+TEST_F(Cli, SetMalformedValueExitsTwo) {
+  const fs::path out = dir_ / "out";
+  const Result r = dydp("run " + quote(msd_scene()) + " --out " + quote(out.string()) +
+                        " --set mass=2,0");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("malformed number '2,0'"), std::string::npos) << r.err;
+  EXPECT_TRUE(entries(out).empty()) << "left in --out: " << join(entries(out));
+}
+
+TEST_F(Cli, SetValueOutsideRangeNamesTheParameterLine) {
+  const fs::path out = dir_ / "out";
+  const Result r = dydp("run " + quote(msd_scene()) + " --out " + quote(out.string()) +
+                        " --set mass=100");
+  EXPECT_EQ(r.status, 2) << r.err;
+  // mass is defined on line 8 of the scene.
+  EXPECT_EQ(r.err.rfind(msd_scene() + ":8: parameters.mass: ", 0), 0u) << r.err;
+  EXPECT_TRUE(entries(out).empty()) << "left in --out: " << join(entries(out));
+}
+
+TEST_F(Cli, SetWithoutEqualsExitsTwo) {
+  const Result r = dydp("run " + quote(msd_scene()) + " --out " + quote((dir_ / "out").string()) +
+                        " --set mass");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("NAME=VALUE"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, UnknownCommandLineOptionExitsTwo) {
+  const Result r = dydp("run " + quote(msd_scene()) + " --outt x");
+  EXPECT_EQ(r.status, 2) << r.err;
+}
+
+// ---------------------------------------------------------------- the output folder contract
+
+/// The signals of msd_sensitivity.yaml, in its outputs: order, and its sensitivity parameters.
+const std::vector<std::string> kMsdSignals = {"body.x", "body.v", "body.a"};
+const std::vector<std::string> kMsdParams = {"mass", "stiffness", "damping"};
+
+TEST_F(Cli, RunWritesTheThreeFilesAndNothingElse) {
+  const fs::path out = dir_ / "out";
+  const Result r = dydp("run " + quote(msd_scene()) + " --out " + quote(out.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<std::string> names = entries(out);
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"objectives.json", "run.json", "signals.csv"}))
+      << "no temporary file may be left behind";
+}
+
+TEST_F(Cli, SignalsCsvHeaderAndRows) {
+  const fs::path out = dir_ / "out";
+  const Result r = dydp("run " + quote(msd_scene()) + " --out " + quote(out.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::vector<std::string> lines = split(read_text(out / "signals.csv"), '\n');
+  ASSERT_FALSE(lines.empty());
+
+  std::vector<std::string> expected = {"t"};
+  for (const auto& s : kMsdSignals) expected.push_back(s);
+  for (const auto& p : kMsdParams)
+    for (const auto& s : kMsdSignals) expected.push_back("d(" + s + ")/d(" + p + ")");
+  EXPECT_EQ(split(lines[0], ','), expected);
+
+  // time: {start: 0, stop: 10, output_step: 0.01}: 1001 rows after the header.
+  ASSERT_EQ(lines.size(), 1u + 1001u);
+  for (size_t k = 1; k < lines.size(); ++k) {
+    const auto cells = split(lines[k], ',');
+    ASSERT_EQ(cells.size(), expected.size()) << "row " << k;
+    for (const auto& c : cells) ASSERT_TRUE(std::isfinite(std::stod(c))) << "row " << k << ": " << c;
+    EXPECT_NEAR(std::stod(cells[0]), 0.01 * static_cast<double>(k - 1), 1e-9) << "row " << k;
+  }
+  // First row: x(0) = x0 = 0.05 and the initial position does not depend on m, k or c.
+  const auto first = split(lines[1], ',');
+  EXPECT_DOUBLE_EQ(std::stod(first[1]), 0.05);
+  EXPECT_DOUBLE_EQ(std::stod(first[4]), 0.0);  // d(body.x)/d(mass)
+  EXPECT_DOUBLE_EQ(std::stod(first[7]), 0.0);  // d(body.x)/d(stiffness)
+  // Later rows carry non-zero sensitivities.
+  const auto last = split(lines.back(), ',');
+  EXPECT_NE(std::stod(last[4]), 0.0);
+}
+
+TEST_F(Cli, ObjectivesJson) {
+  const fs::path out = dir_ / "out";
+  const Result r = dydp("run " + quote(msd_scene()) + " --out " + quote(out.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  json j;
+  ASSERT_NO_THROW(j = json::parse(read_text(out / "objectives.json")));
+  ASSERT_TRUE(j.contains("objectives"));
+  ASSERT_TRUE(j["objectives"].contains("x_rms")) << j.dump();
+  const json& o = j["objectives"]["x_rms"];
+  ASSERT_TRUE(o["value"].is_number()) << o.dump();
+  EXPECT_GT(o["value"].get<double>(), 0.0);
+  ASSERT_TRUE(o["sensitivity"].is_object()) << o.dump();
+  EXPECT_EQ(o["sensitivity"].size(), kMsdParams.size()) << o.dump();
+  for (const auto& p : kMsdParams) {
+    ASSERT_TRUE(o["sensitivity"].contains(p)) << p;
+    ASSERT_TRUE(o["sensitivity"][p].is_number()) << p;
+    EXPECT_TRUE(std::isfinite(o["sensitivity"][p].get<double>())) << p;
+    EXPECT_NE(o["sensitivity"][p].get<double>(), 0.0) << p;
+  }
+}
+
+TEST_F(Cli, RunJsonKeys) {
+  const fs::path out = dir_ / "out";
+  const Result r = dydp("run " + quote(msd_scene()) + " --out " + quote(out.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  json j;
+  ASSERT_NO_THROW(j = json::parse(read_text(out / "run.json")));
+  for (const char* key : {"solver", "rtol", "atol", "steps", "rhs_evaluations",
+                          "sensitivity_rhs_evaluations", "jacobian_evaluations", "cpu_seconds",
+                          "simulated_seconds", "realtime_factor", "pruned_blocks", "warnings"})
+    EXPECT_TRUE(j.contains(key)) << "run.json lacks " << key << ": " << j.dump();
+  EXPECT_EQ(j.value("solver", ""), "bdf");
+  EXPECT_DOUBLE_EQ(j.value("rtol", 0.0), 1e-8);
+  EXPECT_DOUBLE_EQ(j.value("atol", 0.0), 1e-10);
+  EXPECT_GT(j.value("steps", 0L), 0);
+  EXPECT_GT(j.value("rhs_evaluations", 0L), 0);
+  EXPECT_GT(j.value("sensitivity_rhs_evaluations", 0L), 0);
+  EXPECT_DOUBLE_EQ(j.value("simulated_seconds", 0.0), 10.0);
+  EXPECT_GE(j.value("cpu_seconds", -1.0), 0.0);
+  EXPECT_TRUE(j["pruned_blocks"].is_array());
+  EXPECT_TRUE(j["pruned_blocks"].empty());
+  EXPECT_TRUE(j["warnings"].is_array());
+  ASSERT_TRUE(j.contains("parameters"));
+  EXPECT_DOUBLE_EQ(j["parameters"]["mass"]["value"].get<double>(), 1.5);
+}
+
+TEST_F(Cli, SetChangesTheObjectiveAndRunJson) {
+  const fs::path base = dir_ / "base", heavy = dir_ / "heavy";
+  ASSERT_EQ(dydp("run " + quote(msd_scene()) + " --out " + quote(base.string())).status, 0);
+  const Result r = dydp("run " + quote(msd_scene()) + " --out " + quote(heavy.string()) +
+                        " --set mass=2.0");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json a = json::parse(read_text(base / "objectives.json"));
+  const json b = json::parse(read_text(heavy / "objectives.json"));
+  const double va = a["objectives"]["x_rms"]["value"], vb = b["objectives"]["x_rms"]["value"];
+  EXPECT_GT(std::fabs(va - vb), 1e-6 * std::fabs(va)) << va << " vs " << vb;
+  const json run = json::parse(read_text(heavy / "run.json"));
+  EXPECT_DOUBLE_EQ(run["parameters"]["mass"]["value"].get<double>(), 2.0);
+  EXPECT_DOUBLE_EQ(run["parameters"]["stiffness"]["value"].get<double>(), 40.0);
+}
+
+TEST_F(Cli, NoSensWritesNoSensitivities) {
+  const fs::path out = dir_ / "out";
+  const Result r = dydp("run " + quote(msd_scene()) + " --out " + quote(out.string()) + " --no-sens");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::vector<std::string> lines = split(read_text(out / "signals.csv"), '\n');
+  ASSERT_FALSE(lines.empty());
+  std::vector<std::string> expected = {"t"};
+  for (const auto& s : kMsdSignals) expected.push_back(s);
+  EXPECT_EQ(split(lines[0], ','), expected);
+  EXPECT_EQ(lines.size(), 1u + 1001u);
+  const json j = json::parse(read_text(out / "objectives.json"));
+  ASSERT_TRUE(j["objectives"].contains("x_rms"));
+  EXPECT_TRUE(j["objectives"]["x_rms"]["value"].is_number());
+  ASSERT_TRUE(j["objectives"]["x_rms"]["sensitivity"].is_object());
+  EXPECT_TRUE(j["objectives"]["x_rms"]["sensitivity"].empty());
+  const json run = json::parse(read_text(out / "run.json"));
+  EXPECT_EQ(run.value("sensitivity_rhs_evaluations", -1L), 0);
+}
+
+TEST_F(Cli, OutputFilesAreReplacedByRenameNotRewrittenInPlace) {
+  // A hard link to a previous signals.csv must keep the old bytes: the new file is written
+  // under a temporary name and renamed over the old one, never truncated and rewritten.
+  const fs::path out = dir_ / "out";
+  fs::create_directories(out);
+  const fs::path witness = dir_ / "witness.csv";
+  write("witness.csv", "old contents\n");
+  fs::create_hard_link(witness, out / "signals.csv");
+  const Result r = dydp("run " + quote(msd_scene()) + " --out " + quote(out.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(read_text(witness), "old contents\n");
+  EXPECT_EQ(read_text(out / "signals.csv").rfind("t,body.x,", 0), 0u);
+}
+
+TEST_F(Cli, PrunedBlocksInRunJson) {
+  const std::string scene = write("pruned.yaml", R"(scene: pruned
+time: {stop: 0.5, output_step: 0.1}
+solver: {method: rk4, step: 0.01}
+blocks:
+  src: {type: source.sine}
+  spare: {type: math.gain}
+connections:
+  - src.y -> spare.u
+outputs: [src.y]
+)");
+  const fs::path out = dir_ / "out";
+  const Result r = dydp("run " + quote(scene) + " --out " + quote(out.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json run = json::parse(read_text(out / "run.json"));
+  EXPECT_EQ(run["pruned_blocks"], json::array({"spare"}));
+  EXPECT_EQ(run.value("solver", ""), "rk4");
+  const std::vector<std::string> lines = split(read_text(out / "signals.csv"), '\n');
+  EXPECT_EQ(lines.size(), 1u + 6u);
+  EXPECT_EQ(lines.at(0), "t,src.y");
+}
+
+// ---------------------------------------------------------------- solver failure: exit 1
+
+TEST_F(Cli, SolverFailureExitsOneNamingBlockAndTime) {
+  // rk4 with h = 0.1 s on a lag of tau = 1e-6 s: |1 + z + z^2/2 + z^3/6 + z^4/24| >> 1 for
+  // z = -h/tau, so the state grows without bound and overflows within a few dozen steps.
+  const std::string scene = write("unstable.yaml", R"(scene: unstable
+time: {stop: 20.0, output_step: 0.1}
+solver: {method: rk4, step: 0.1}
+blocks:
+  src: {type: source.constant, value: 1.0}
+  fast_lag: {type: math.lag, tau: 1.0e-6}
+connections:
+  - src.y -> fast_lag.u
+outputs: [fast_lag.y]
+)");
+  const fs::path out = dir_ / "out";
+  const Result r = dydp("run " + quote(scene) + " --out " + quote(out.string()));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("block fast_lag"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("t = "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("not finite"), std::string::npos) << r.err;
+  EXPECT_TRUE(entries(out).empty()) << "left in --out: " << join(entries(out));
+}
+
+// ---------------------------------------------------------------- dydp blocks
+
+TEST_F(Cli, BlocksListsEveryRegisteredType) {
+  const Result r = dydp("blocks");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto types = dydp::engine::Registry::global().all();
+  ASSERT_FALSE(types.empty()) << "the test binary must link dydp_blocks";
+  for (const auto* t : types)
+    EXPECT_NE(r.out.find(t->name + " "), std::string::npos) << t->name << " not listed";
+  for (const char* name : {"mass_spring_damper", "source.sine", "source.table", "math.lag",
+                           "objective.rms"})
+    EXPECT_NE(r.out.find(name), std::string::npos) << name << " not listed";
+}
+
+}  // namespace
