@@ -68,13 +68,18 @@ Context::Context() {
 
 std::uint64_t Context::hash_of(Op op, std::span<const NodeId> children,
                                std::uint64_t payload) const {
-  std::uint64_t h = 0x9E3779B97F4A7C15ull ^ (static_cast<std::uint64_t>(op) << 56) ^ payload;
-  h *= 0xBF58476D1CE4E5B9ull;
-  for (NodeId c : children) {
-    h ^= c + 0x9E3779B97F4A7C15ull + (h << 6) + (h >> 2);
-    h *= 0x94D049BB133111EBull;
-  }
-  return h ^ (h >> 31);
+  // splitmix64 finaliser on each word: constants differ mostly in their high bits, and the
+  // table is indexed by the low bits.
+  auto mix = [](std::uint64_t x) {
+    x ^= x >> 30;
+    x *= 0xBF58476D1CE4E5B9ull;
+    x ^= x >> 27;
+    x *= 0x94D049BB133111EBull;
+    return x ^ (x >> 31);
+  };
+  std::uint64_t h = mix(payload ^ (static_cast<std::uint64_t>(op) << 56));
+  for (NodeId c : children) h = mix(h ^ (c + 0x9E3779B97F4A7C15ull));
+  return h;
 }
 
 void Context::grow_table() {
@@ -146,9 +151,13 @@ const Symbol* Context::find_symbol(std::string_view name) const {
 
 std::string Context::unique_name(std::string_view wanted) {
   std::string base = sanitize(wanted);
-  std::string name = base;
-  for (int k = 1; names_.count(name) != 0; ++k) name = base + "_" + std::to_string(k);
-  names_.insert(name);
+  if (names_.insert(base).second) return base;
+  // next free numbered variant, remembered per base so repeated names stay O(1)
+  std::size_t& k = next_suffix_[base];
+  std::string name;
+  do {
+    name = base + "_" + std::to_string(++k);
+  } while (!names_.insert(name).second);
   return name;
 }
 

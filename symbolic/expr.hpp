@@ -161,6 +161,7 @@ class Context {
   std::vector<Symbol> symbols_;
   std::vector<Array> arrays_;
   std::unordered_set<std::string> names_;
+  std::unordered_map<std::string, std::size_t> next_suffix_;
   std::unordered_map<NodeId, std::string> abbreviations_;
   std::unordered_map<std::string, std::size_t> symbol_by_name_;
 };
