@@ -18,6 +18,10 @@ Evaluator::Evaluator(const Diagram& d, bool with_sensitivities)
     u_offset_.push_back(static_cast<int>(u_.size()));
     for (int src : n.input_source) u_.push_back(sig_.data() + src);
     max_ports = std::max({max_ports, n.block->inputs().size(), n.block->outputs().size()});
+    bool driven = false;
+    for (int dir = 0; dir < ns_; ++dir)
+      for (size_t j = 0; j < n.p.size(); ++j) driven = driven || d.parameter_seed(n, j, dir) != 0.0;
+    driven_.push_back(driven);
   }
   du_.resize(max_ports);
   dy_.resize(max_ports);
@@ -43,10 +47,9 @@ Seeds Evaluator::seeds_for(const Node& n, int index, int nd, ConstDirView dx, bo
   s.x = dx.zero() || n.block->num_states() == 0 ? ConstDirView{}
                                                  : ConstDirView{dx.data + n.state_offset, dx.ld};
   s.u = du_.data();
-  const bool any_param = with_params && !n.p.empty() &&
-      std::any_of(n.p_scene.begin(), n.p_scene.end(), [](int i) { return i >= 0; });
-  s.p = any_param ? ConstDirView{pseed_.data() + pseed_offset_[index], static_cast<int>(n.p.size())}
-                  : ConstDirView{};
+  s.p = with_params && driven_[index]
+            ? ConstDirView{pseed_.data() + pseed_offset_[index], static_cast<int>(n.p.size())}
+            : ConstDirView{};
   return s;
 }
 
@@ -124,14 +127,23 @@ void Evaluator::tangents(double t, const double* x, int nd, ConstDirView dx, boo
     }
   for (size_t i = 0; i < d_.nodes.size(); ++i) {
     const Node& n = d_.nodes[i];
+    const bool states = dxdot.data && n.block->num_states() > 0;
+    const bool quads = dqdot.data && n.block->num_quadratures() > 0;
+    if (!states && !quads) continue;
     const int idx = static_cast<int>(i);
-    if (dxdot.data && n.block->num_states() > 0)
-      n.block->derivatives_tangent(eval_for(n, idx, t, x), seeds_for(n, idx, nd, dx, with_params),
-                                   {dxdot.data + n.state_offset, dxdot.ld});
-    if (dqdot.data && n.block->num_quadratures() > 0)
-      n.block->quadratures_tangent(eval_for(n, idx, t, x), seeds_for(n, idx, nd, dx, with_params),
-                                   {dqdot.data + n.quad_offset, dqdot.ld});
+    const Eval e = eval_for(n, idx, t, x);
+    const Seeds s = seeds_for(n, idx, nd, dx, with_params);
+    if (states) n.block->derivatives_tangent(e, s, {dxdot.data + n.state_offset, dxdot.ld});
+    if (quads) n.block->quadratures_tangent(e, s, {dqdot.data + n.quad_offset, dqdot.ld});
   }
+}
+
+bool Evaluator::all_finite(const double* xdot) const {
+  // One sum decides the common case; an overflow to inf merely sends us to the full scan.
+  double sum = 0.0;
+  for (double v : sig_) sum += v * 0.0;
+  for (int i = 0; i < d_.num_states; ++i) sum += xdot[i] * 0.0;
+  return sum == 0.0;
 }
 
 std::string Evaluator::find_nonfinite(const double* xdot) const {

@@ -43,6 +43,8 @@ class Evaluator {
   /// Names the first block whose outputs or derivatives (xdot, may be null) are not finite;
   /// empty when all are.
   std::string find_nonfinite(const double* xdot) const;
+  /// Fast check that every signal and xdot[0, num_states) is finite.
+  bool all_finite(const double* xdot) const;
 
  private:
   Eval eval_for(const Node& n, int index, double t, const double* x) const;
@@ -54,6 +56,7 @@ class Evaluator {
   std::vector<double> sig_, dsig_;
   std::vector<double> pseed_;          ///< per node np x ns, d-major, concatenated
   std::vector<int> pseed_offset_;
+  std::vector<bool> driven_;           ///< node has a parameter driven by a direction
   std::vector<const double*> u_;       ///< input pointers, per node concatenated
   std::vector<int> u_offset_;
   std::vector<double*> y_;             ///< output pointers, per node concatenated

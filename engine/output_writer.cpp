@@ -72,6 +72,7 @@ std::string run_json(const Diagram& d, const RunResult& r) {
       {"rtol", s.rtol},
       {"atol", s.atol},
       {"fixed_step", s.step},
+      {"sens_error_test", d.solver.sens_error_test},
       {"parameters", parameters},
       {"sensitivities", r.sensitivity_names},
       {"states", d.num_states},

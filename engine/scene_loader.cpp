@@ -45,7 +45,7 @@ class SceneReader {
     for (auto kv : map) {
       const std::string key = kv.first.Scalar();
       if (std::none_of(keys.begin(), keys.end(), [&](const char* k) { return key == k; }))
-        fail(kv.first, field + "." + key, "unknown key");
+        fail(kv.first, field.empty() ? key : field + "." + key, "unknown key");
     }
   }
 
@@ -70,7 +70,7 @@ void read_time(const SceneReader& r, const YAML::Node& n, TimeSpec& time) {
 
 void read_solver(const SceneReader& r, const YAML::Node& n, SolverSpec& s) {
   if (!n) return;
-  r.allow_keys(n, "solver", {"method", "rtol", "atol", "step", "max_steps"});
+  r.allow_keys(n, "solver", {"method", "rtol", "atol", "step", "max_steps", "sens_error_test"});
   if (n["method"]) {
     s.method = r.text(n["method"], "solver.method");
     if (s.method != "bdf" && s.method != "adams" && s.method != "rk4")
@@ -79,6 +79,11 @@ void read_solver(const SceneReader& r, const YAML::Node& n, SolverSpec& s) {
   if (n["rtol"]) s.rtol = r.number(n["rtol"], "solver.rtol");
   if (n["atol"]) s.atol = r.number(n["atol"], "solver.atol");
   if (n["step"]) s.step = r.number(n["step"], "solver.step");
+  if (const YAML::Node e = n["sens_error_test"]) {
+    const std::string v = r.text(e, "solver.sens_error_test");
+    if (v != "true" && v != "false") r.fail(e, "solver.sens_error_test", "expected true or false");
+    s.sens_error_test = v == "true";
+  }
   if (n["max_steps"]) s.max_steps = static_cast<long>(r.number(n["max_steps"], "solver.max_steps"));
   if (!(s.rtol > 0)) r.fail(n["rtol"], "solver.rtol", "must be positive");
   if (!(s.atol > 0)) r.fail(n["atol"], "solver.atol", "must be positive");
@@ -213,7 +218,7 @@ Diagram load_scene(const std::string& path,
     throw InputError(path, e.mark.line + 1, "", "YAML syntax: " + e.msg);
   }
   if (!root.IsMap()) throw InputError(path, 1, "", "a scene is a YAML mapping");
-  r.allow_keys(root, "scene", {"scene", "description", "time", "solver", "parameters",
+  r.allow_keys(root, "", {"scene", "description", "time", "solver", "parameters",
                                "sensitivities", "blocks", "connections", "outputs", "layout"});
 
   Diagram d;
