@@ -40,7 +40,8 @@ class Differentiator {
   NodeId compute(NodeId n) {
     const Op op = ctx_.op(n);
     if (op == Op::Constant || op == Op::Symbol) return zero_;  // seeded symbols are memoised
-    const auto kids = ctx_.children(n);
+    // a copy: building derivative nodes may move the context's children storage
+    const std::vector<NodeId> kids(ctx_.children(n).begin(), ctx_.children(n).end());
     std::vector<NodeId> dk(kids.size());
     bool all_zero = true;
     for (std::size_t i = 0; i < kids.size(); ++i) {
@@ -123,12 +124,12 @@ class Differentiator {
 
 Direction along(Expr symbol) {
   if (symbol.op() != Op::Symbol) throw std::invalid_argument("symbolic: along() needs a symbol");
-  return Direction{symbol.context().symbol(symbol.id()).name,
-                   {{symbol.id(), symbol.context().one().id()}}};
+  const std::string& name = symbol.context().symbol(symbol.id()).name;
+  return Direction{name, name, {{symbol.id(), symbol.context().one().id()}}};
 }
 
 Direction seeded(Context& context, std::span<const ArrayId> arrays) {
-  Direction dir{"d", {}};
+  Direction dir{"d", "seed", {}};
   for (ArrayId a : arrays) {
     const ArrayId s = context.seed_array(a);
     const auto& elements = context.array(a).elements;
@@ -158,7 +159,8 @@ EquationList differentiate(const EquationList& list, std::span<const Direction> 
       diff.set(a.target, target);
     }
     for (const Output& o : list.outputs()) {
-      derivative_outputs.push_back(Output{"d(" + o.name + ")/d(" + dir.suffix + ")", diff.d(o.value)});
+      const std::string& label = dir.label.empty() ? dir.suffix : dir.label;
+      derivative_outputs.push_back(Output{"d(" + o.name + ")/d(" + label + ")", diff.d(o.value)});
     }
   }
   for (Output& o : derivative_outputs) result.add_output(std::move(o));

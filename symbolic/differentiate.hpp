@@ -15,14 +15,16 @@ namespace dydp::symbolic {
 // A direction of differentiation: the derivative of each listed symbol along it (every other
 // input, parameter or seed symbol has derivative zero).
 struct Direction {
-  std::string suffix;  // derivative auxiliaries are named `A_<suffix>`, outputs `d(y)/d(<suffix>)`
+  std::string suffix;  // derivative auxiliaries are named `A_<suffix>`
+  std::string label;   // derivative outputs are named `d(y)/d(<label>)`; the suffix when empty
   std::vector<std::pair<NodeId, NodeId>> seeds;  // (symbol, its derivative)
 };
 
 // d/d(symbol): the symbol has derivative 1; named after the symbol.
 Direction along(Expr symbol);
 // The generic direction of a tangent function: element i of each array has derivative
-// `d<array>[i]`, element i of the array's Seed array (see Context::seed_array). Suffix "d".
+// `d<array>[i]`, element i of the array's Seed array (see Context::seed_array). Suffix "d",
+// label "seed".
 Direction seeded(Context& context, std::span<const ArrayId> arrays);
 
 // The input list (all of it, as the primal part) followed by the derivative assignments, one

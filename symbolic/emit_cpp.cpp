@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <algorithm>
 #include <stdexcept>
 
 #include "symbolic/op_count.hpp"
@@ -75,18 +76,18 @@ class Printer {
         return;
       }
       case Op::Add: {
-        bool first = true;
-        for (NodeId t : ctx_.children(n)) {
-          if (first) print(t, out);
-          else print_term(t, out);
-          first = false;
-        }
+        // `b - a` rather than `-a + b`: swapping the first two terms leaves the sum unchanged.
+        std::vector<NodeId> terms(ctx_.children(n).begin(), ctx_.children(n).end());
+        if (is_negative_term(terms[0]) && !is_negative_term(terms[1])) std::swap(terms[0], terms[1]);
+        print(terms[0], out);
+        for (std::size_t i = 1; i < terms.size(); ++i) print_term(terms[i], out);
         return;
       }
       case Op::Mul: print_product(n, false, out); return;
       case Op::Neg:
+        // -a*b: (-a)*b and -(a*b) are the same double
         out += "-";
-        wrapped(ctx_.children(n)[0], 2, out);
+        wrapped(ctx_.children(n)[0], 1, out);
         return;
       case Op::Div:
         wrapped(ctx_.children(n)[0], 1, out);
@@ -149,6 +150,18 @@ class Printer {
   }
 
  private:
+  bool is_negative_term(NodeId t) const {
+    switch (ctx_.op(t)) {
+      case Op::Neg: return true;
+      case Op::Constant: return ctx_.value(t) < 0.0;
+      case Op::Mul: {
+        const NodeId c = ctx_.children(t)[0];
+        return ctx_.op(c) == Op::Constant && ctx_.value(c) < 0.0;
+      }
+      default: return false;
+    }
+  }
+
   void wrapped(NodeId n, int needed, std::string& out) const {
     if (precedence(ctx_, n) >= needed) {
       print(n, out);
@@ -263,7 +276,12 @@ std::vector<NodeId> abbreviations_used(const EquationList& list) {
   };
   for (const Assignment& a : list.assignments()) walk(a.value);
   for (const Output& o : list.outputs()) walk(o.value);
-  std::sort(found.begin(), found.end());
+  // by argument, sine before cosine: S2, C2, S3, C3
+  std::sort(found.begin(), found.end(), [&](NodeId a, NodeId b) {
+    const NodeId xa = ctx.children(a)[0], xb = ctx.children(b)[0];
+    if (xa != xb) return xa < xb;
+    return ctx.op(a) == Op::Sin && ctx.op(b) != Op::Sin;
+  });
   return found;
 }
 

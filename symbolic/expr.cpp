@@ -107,6 +107,13 @@ NodeId Context::intern(Op op, std::span<const NodeId> kids, std::uint64_t payloa
       if (std::equal(existing.begin(), existing.end(), kids.begin())) return id;
     }
   }
+  // `kids` may point into children_ itself (a sub-range of an existing node): copy it before
+  // children_ grows.
+  std::vector<NodeId> own_copy;
+  if (!kids.empty() && kids.data() >= children_.data() && kids.data() < children_.data() + children_.size()) {
+    own_copy.assign(kids.begin(), kids.end());
+    kids = own_copy;
+  }
   const auto id = static_cast<NodeId>(nodes_.size());
   if (id == kEmpty) throw std::length_error("symbolic::Context: too many nodes");
   nodes_.push_back(Node{op, static_cast<std::uint32_t>(kids.size()),

@@ -118,6 +118,7 @@ class Context {
   // --- node inspection --------------------------------------------------------------------
   std::size_t size() const { return nodes_.size(); }
   Op op(NodeId n) const { return nodes_[n].op; }
+  // Valid until the next node is built: copy it before building nodes from its elements.
   std::span<const NodeId> children(NodeId n) const {
     return {children_.data() + nodes_[n].first_child, nodes_[n].child_count};
   }

@@ -165,8 +165,9 @@ NodeId Context::make_neg(NodeId a) {
     }
     case Op::Add: {
       // -(a + b) = -a - b keeps one canonical form for every sum.
-      std::vector<NodeId> k;
-      for (NodeId t : children(a)) k.push_back(make_neg(t));
+      // copied first: building nodes may move the children storage
+      std::vector<NodeId> k(children(a).begin(), children(a).end());
+      for (NodeId& t : k) t = make_neg(t);
       return make_add(k);
     }
     default: return intern(Op::Neg, std::span<const NodeId>(&a, 1), 0);
@@ -213,8 +214,8 @@ NodeId Context::make_pow(NodeId base, NodeId exponent) {
         return std::fmod(std::fabs(e), 2.0) == 1.0 ? make_neg(p) : p;
       }
       if (op(base) == Op::Mul) {
-        std::vector<NodeId> k;
-        for (NodeId f : children(base)) k.push_back(make_pow(f, exponent));
+        std::vector<NodeId> k(children(base).begin(), children(base).end());
+        for (NodeId& f : k) f = make_pow(f, exponent);
         return make_mul(k);
       }
     }

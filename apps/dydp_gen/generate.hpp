@@ -1,0 +1,44 @@
+// Turning one model's equation list into generated C++ and statistics: elimination, optional
+// in-extenso expansion, the tangent, emission, op counts. Independent of the model format, so
+// each front end (.eqs now, .mbs.yaml later) only has to produce a GenerationInput.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "symbolic/equation_list.hpp"
+#include "symbolic/op_count.hpp"
+
+namespace dydp::gen {
+
+struct GenerationInput {
+  std::string name;    // function name; the files are NAME.hpp and NAME.cpp
+  std::string origin;  // for the header comment: source file and options
+  const symbolic::EquationList* list = nullptr;
+  std::vector<symbolic::ArrayId> tangent_arrays;  // empty: no tangent function
+};
+
+struct FunctionStats {
+  std::string name;
+  std::size_t equations_before = 0;
+  std::size_t equations_after = 0;
+  symbolic::OpCount ops;
+};
+
+struct GenerationOptions {
+  std::filesystem::path out_dir;
+  bool expand = false;  // emit the in-extenso form instead of the recursive one
+};
+
+// Writes NAME.hpp and NAME.cpp into out_dir (each through a temporary name, then renamed) and
+// returns the statistics of every emitted function.
+std::vector<FunctionStats> generate(const GenerationInput& input, const GenerationOptions& options);
+
+// stats.json as in the CLI contract of docs (DESIGN.md, section 5).
+std::string stats_json(const std::vector<FunctionStats>& functions, double seconds);
+
+// Writes `text` to `path` through a temporary file in the same folder, then renames it.
+void write_atomically(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace dydp::gen
