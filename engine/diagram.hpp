@@ -82,8 +82,9 @@ class Diagram {
   int num_quadratures = 0;
 
   int find_parameter(const std::string& name) const;
-  /// Sets a scene parameter and every block parameter it drives; checks the bounds of both.
-  void set_parameter(int index, double value);
+  /// Sets a scene parameter and every block parameter it drives; checks the bounds of both
+  /// (the scene parameter's range only with check_range: finite differences step past it).
+  void set_parameter(int index, double value, bool check_range = true);
   /// Seed of block parameter j of node n in sensitivity direction d.
   double parameter_seed(const Node& n, int j, int d) const {
     return n.p_scene[j] >= 0 && n.p_scene[j] == sensitivities[d] ? 1.0 : 0.0;

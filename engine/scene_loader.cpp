@@ -290,9 +290,9 @@ int Diagram::find_parameter(const std::string& name) const {
   return -1;
 }
 
-void Diagram::set_parameter(int index, double value) {
+void Diagram::set_parameter(int index, double value, bool check_range) {
   SceneParameter& sp = parameters.at(index);
-  if (value < sp.lower || value > sp.upper)
+  if (check_range && (value < sp.lower || value > sp.upper))
     throw InputError(file, sp.line, "parameters." + sp.name,
                      "value " + std::to_string(value) + " outside its range");
   // Check every block parameter it drives before changing any: a refused value leaves none behind.

@@ -15,7 +15,19 @@ struct RunArgs {
   bool report = false;
 };
 
+struct SweepArgs {
+  std::string scene;
+  std::string out = "out";
+  std::vector<std::string> sets;
+  std::string parameter;
+  std::string range;              ///< LO:HI:N
+  std::vector<double> fd_steps;   ///< --fd: absolute steps for central differences
+  double delta = 0.0;             ///< --delta: report the change of psi for this step of p
+  bool report = false;
+};
+
 int run_command(const RunArgs& args);
+int sweep_command(const SweepArgs& args);
 int blocks_command(std::ostream& out);
 
 /// Splits NAME=VALUE pairs; throws InputError naming --set on a malformed one.

@@ -21,6 +21,17 @@ int main(int argc, char** argv) {
   run->add_flag("--no-sens", run_args.no_sens, "run without sensitivities");
   run->add_flag("--report", run_args.report, "also write plots (gnuplot) and report.md");
 
+  dydp::apps::SweepArgs sweep_args;
+  CLI::App* sweep = app.add_subcommand("sweep", "psi and d(psi)/dp over a range of one parameter");
+  sweep->add_option("scene", sweep_args.scene, "scene file (YAML)")->required();
+  sweep->add_option("--param", sweep_args.parameter, "scene parameter to sweep")->required();
+  sweep->add_option("--range", sweep_args.range, "LO:HI:N")->required();
+  sweep->add_option("--out", sweep_args.out, "output folder")->capture_default_str();
+  sweep->add_option("--set", sweep_args.sets, "override a scene parameter: NAME=VALUE");
+  sweep->add_option("--fd", sweep_args.fd_steps, "central differences at these absolute steps")->delimiter(',');
+  sweep->add_option("--delta", sweep_args.delta, "report the change of psi for this step of the parameter");
+  sweep->add_flag("--report", sweep_args.report, "also write plots (gnuplot) and report.md");
+
   CLI::App* blocks = app.add_subcommand("blocks", "List the block types with ports and parameters");
 
   try {
@@ -32,6 +43,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*run) return dydp::apps::run_command(run_args);
+    if (*sweep) return dydp::apps::sweep_command(sweep_args);
     if (*blocks) return dydp::apps::blocks_command(std::cout);
   } catch (const dydp::engine::InputError& e) {
     std::cerr << e.what() << "\n";

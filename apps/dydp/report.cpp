@@ -6,16 +6,11 @@
 #include <iomanip>
 #include <sstream>
 
+#include "apps/dydp/gnuplot.hpp"
 #include "engine/output_writer.hpp"
 
 namespace dydp::apps {
 namespace {
-
-std::string file_safe(const std::string& name) {
-  std::string s;
-  for (char c : name) s += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-  return s;
-}
 
 std::string unit_of(const engine::Diagram& d, const std::string& signal) {
   const std::string port = signal.substr(0, signal.find('['));
@@ -27,12 +22,9 @@ std::string unit_of(const engine::Diagram& d, const std::string& signal) {
   return "";
 }
 
-bool have_gnuplot() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
-
 }  // namespace
 
 void write_report(const std::string& dir, const engine::Diagram& d, const engine::RunResult& r) {
-  namespace fs = std::filesystem;
   const int nsig = r.num_signals();
   const int ns = static_cast<int>(r.sensitivity_names.size());
   std::ostringstream md;
@@ -69,9 +61,8 @@ void write_report(const std::string& dir, const engine::Diagram& d, const engine
   if (!have_gnuplot()) {
     md << "gnuplot was not found on the PATH: no plots were made (install gnuplot-nox).\n";
   } else {
-    fs::create_directories(dir + "/plots");
     std::ostringstream gp;
-    gp << "set terminal pngcairo size 900,640 font 'Sans,10'\nset datafile separator ','\n"
+    gp << "set terminal pngcairo noenhanced size 900,640 font 'Sans,10'\nset datafile separator ','\n"
           "set grid\nset key outside right top\n";
     for (int i = 0; i < nsig; ++i) {
       const std::string& name = r.signal_names[i];
@@ -95,10 +86,7 @@ void write_report(const std::string& dir, const engine::Diagram& d, const engine
       gp << "unset multiplot\n";
       md << "### " << name << "\n\n![" << name << "](" << png << ")\n\n";
     }
-    const std::string script = dir + "/plots/report.gp";
-    engine::write_file_atomically(script, gp.str());
-    if (std::system(("gnuplot '" + script + "' 2>" + dir + "/plots/gnuplot.log").c_str()) != 0)
-      md << "gnuplot failed: see plots/gnuplot.log.\n";
+    if (!run_gnuplot(dir, "signals", gp.str())) md << "gnuplot failed: see plots/signals.log.\n";
   }
   if (ns > 0)
     md << "Lower panels: sensitivities scaled by their parameter's value, p * dS/dp, the change of S "

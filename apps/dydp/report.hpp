@@ -6,11 +6,18 @@
 
 #include "engine/diagram.hpp"
 #include "engine/run.hpp"
+#include "engine/sweep.hpp"
 
 namespace dydp::apps {
 
 /// Writes DIR/report.md and DIR/plots/*.png (needs DIR/signals.csv, written before).
 /// Without gnuplot on the PATH, report.md says so and no plot is made.
 void write_report(const std::string& dir, const engine::Diagram& d, const engine::RunResult& r);
+
+/// Writes DIR/report.md and DIR/plots/*.png for a sweep: psi and d(psi)/dp against p, the
+/// finite-difference error against step, the sensitivity history as a surface over (t, p) and
+/// the logged signals for several p.
+void write_sweep_report(const std::string& dir, const std::string& scene,
+                        const engine::SweepResult& r, double delta);
 
 }  // namespace dydp::apps

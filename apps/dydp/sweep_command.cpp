@@ -1,0 +1,109 @@
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "apps/dydp/commands.hpp"
+#include "apps/dydp/report.hpp"
+#include "engine/errors.hpp"
+#include "engine/output_writer.hpp"
+#include "engine/sweep.hpp"
+
+namespace dydp::apps {
+namespace {
+
+/// "LO:HI:N" -> low, high, points.
+void parse_range(const std::string& text, engine::SweepSpec& spec) {
+  std::stringstream ss(text);
+  std::string lo, hi, n;
+  double points = 0;
+  if (!std::getline(ss, lo, ':') || !std::getline(ss, hi, ':') || !std::getline(ss, n) ||
+      !engine::parse_number(lo, spec.low) || !engine::parse_number(hi, spec.high) ||
+      !engine::parse_number(n, points) || points < 1 || points != std::floor(points) || spec.high < spec.low)
+    throw engine::InputError("--range", 0, text, "expected LO:HI:N with LO <= HI and N >= 1");
+  spec.points = static_cast<int>(points);
+}
+
+std::string sweep_csv(const engine::SweepResult& r, double delta) {
+  std::ostringstream out;
+  out.precision(12);
+  out << r.parameter;
+  for (const auto& o : r.objectives) {
+    out << ',' << o << ",d(" << o << ")/d(" << r.parameter << "),normalised(" << o << ")";
+    if (delta > 0) out << ",change(" << o << ")for_step_" << delta;
+    for (double h : r.fd_steps) out << ",fd(" << o << ")h=" << h << ",fd_error(" << o << ")h=" << h;
+  }
+  out << ",cpu_seconds\n";
+  for (const auto& pt : r.points) {
+    out << pt.p;
+    for (size_t o = 0; o < r.objectives.size(); ++o) {
+      out << ',' << pt.psi[o] << ',' << pt.dpsi[o] << ','
+          << (pt.psi[o] != 0 ? pt.p / pt.psi[o] * pt.dpsi[o] : 0.0);
+      if (delta > 0) out << ',' << pt.dpsi[o] * delta;
+      for (size_t s = 0; s < r.fd_steps.size(); ++s)
+        out << ',' << pt.fd[s][o] << ',' << std::fabs(pt.fd[s][o] - pt.dpsi[o]) / std::max(std::fabs(pt.dpsi[o]), 1e-300);
+    }
+    out << ',' << pt.stats.cpu_seconds << '\n';
+  }
+  return out.str();
+}
+
+}  // namespace
+
+int sweep_command(const SweepArgs& args) {
+  engine::SweepSpec spec;
+  spec.scene = args.scene;
+  spec.overrides = parse_sets(args.sets);
+  spec.parameter = args.parameter;
+  parse_range(args.range, spec);
+  spec.fd_steps = args.fd_steps;
+  for (double h : spec.fd_steps)
+    if (!(h > 0)) throw engine::InputError("--fd", 0, std::to_string(h), "steps must be positive");
+  spec.keep_runs = args.report;
+  std::cerr << "sweep: " << spec.points << " runs of " << args.scene << " over " << spec.parameter
+            << " in [" << spec.low << ", " << spec.high << "]"
+            << (spec.fd_steps.empty() ? "" : ", with central differences") << "\n";
+  const engine::SweepResult r = engine::sweep(spec);
+
+  std::filesystem::create_directories(args.out);
+  const std::string csv = sweep_csv(r, args.delta);
+  nlohmann::ordered_json j;
+  j["parameter"] = r.parameter;
+  j["unit"] = r.unit;
+  j["objectives"] = r.objectives;
+  j["fd_steps"] = r.fd_steps;
+  for (const auto& pt : r.points) {
+    nlohmann::ordered_json p = {{"p", pt.p}, {"cpu_seconds", pt.stats.cpu_seconds}};
+    for (size_t o = 0; o < r.objectives.size(); ++o) {
+      nlohmann::ordered_json obj = {{"value", pt.psi[o]}, {"sensitivity", pt.dpsi[o]},
+                                    {"normalised", pt.psi[o] != 0 ? pt.p / pt.psi[o] * pt.dpsi[o] : 0.0}};
+      for (size_t s = 0; s < r.fd_steps.size(); ++s) obj["fd"].push_back({{"step", r.fd_steps[s]}, {"value", pt.fd[s][o]}});
+      p["objectives"][r.objectives[o]] = obj;
+    }
+    j["points"].push_back(p);
+  }
+  engine::write_file_atomically(args.out + "/sweep.csv", csv);
+  engine::write_file_atomically(args.out + "/sweep.json", j.dump(2) + "\n");
+  if (args.report) write_sweep_report(args.out, args.scene, r, args.delta);
+
+  std::cout << std::setprecision(6);
+  for (size_t o = 0; o < r.objectives.size(); ++o) {
+    std::cout << r.objectives[o] << " against " << r.parameter << (r.unit.empty() ? "" : " [" + r.unit + "]") << ":\n";
+    std::cout << "  " << std::setw(12) << "p" << std::setw(14) << "psi" << std::setw(14) << "dpsi/dp"
+              << std::setw(14) << "% per %";
+    if (args.delta > 0) std::cout << std::setw(14) << ("for +" + std::to_string(args.delta).substr(0, 6));
+    std::cout << "\n";
+    for (const auto& pt : r.points) {
+      std::cout << "  " << std::setw(12) << pt.p << std::setw(14) << pt.psi[o] << std::setw(14) << pt.dpsi[o]
+                << std::setw(14) << (pt.psi[o] != 0 ? pt.p / pt.psi[o] * pt.dpsi[o] : 0.0);
+      if (args.delta > 0) std::cout << std::setw(14) << pt.dpsi[o] * args.delta;
+      std::cout << "\n";
+    }
+  }
+  std::cout << "results in " << args.out << "/ (sweep.csv, sweep.json" << (args.report ? ", report.md" : "") << ")\n";
+  return 0;
+}
+
+}  // namespace dydp::apps
