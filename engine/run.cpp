@@ -2,6 +2,7 @@
 
 #include "engine/cvodes_solver.hpp"
 #include "engine/rk4_solver.hpp"
+#include "engine/sdirk_solver.hpp"
 
 namespace dydp::engine {
 
@@ -13,6 +14,7 @@ int RunResult::signal_index(const std::string& name) const {
 
 RunResult run(const Diagram& d, const RunOptions& options) {
   if (d.solver.method == "rk4") return run_rk4(d, options);
+  if (d.solver.method == "sdirk2") return run_sdirk(d, options);
   return run_cvodes(d, options);
 }
 

@@ -112,10 +112,12 @@ TEST_P(ClosedForm, RmsObjectiveAndSensitivitiesMatch) {
 
 INSTANTIATE_TEST_SUITE_P(Cvodes, ClosedForm, ::testing::Values("bdf", "adams"));
 
-// RK4's sensitivities are the derivative of its discrete map: they agree with central
-// differences of whole RK4 runs (same steps) far better than with the ODE's sensitivities.
-TEST(Rk4, SensitivitiesAreDerivativesOfTheDiscreteSolution) {
-  const std::string solver = "{method: rk4, step: 0.01}";
+// Fixed-step sensitivities are the derivative of the discrete map: they agree with central
+// differences of whole runs (same steps) far better than with the ODE's sensitivities.
+class FixedStep : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(FixedStep, SensitivitiesAreDerivativesOfTheDiscreteSolution) {
+  const std::string solver = GetParam();
   const Diagram d = load(solver);
   const RunResult r = run(d);
   const int ix = r.signal_index("body.x");
@@ -157,9 +159,14 @@ TEST(Rk4, SensitivitiesAreDerivativesOfTheDiscreteSolution) {
   }
 }
 
-TEST(Rk4, DiffersFromTheOdeSensitivityByTheDiscretisationError) {
+INSTANTIATE_TEST_SUITE_P(Methods, FixedStep,
+                         ::testing::Values("{method: rk4, step: 0.01}", "{method: sdirk2, step: 0.01}"));
+
+TEST_P(FixedStep, DiffersFromTheOdeSensitivityByTheDiscretisationError) {
   // With a coarse step the discrete derivative is not the ODE's: the test above is not trivial.
-  const Diagram d = load("{method: rk4, step: 0.05}");
+  std::string solver = GetParam();
+  solver.replace(solver.find("0.01"), 4, "0.05");
+  const Diagram d = load(solver);
   const RunResult r = run(d);
   const int ix = r.signal_index("body.x");
   std::vector<double> dx, dx_ref;

@@ -1,0 +1,205 @@
+#include "engine/sdirk_solver.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+#include "engine/cpu_clock.hpp"
+#include "engine/errors.hpp"
+#include "engine/output_grid.hpp"
+#include "engine/recorder.hpp"
+
+namespace dydp::engine {
+namespace {
+
+using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic>;
+using Vector = Eigen::VectorXd;
+
+const double kGamma = 1.0 - 1.0 / std::sqrt(2.0);
+
+/// The stages of one step share this: the diagram, the evaluator and the iteration matrix.
+class Stepper {
+ public:
+  Stepper(const Diagram& d, Evaluator& ev, int ns, RunStats& stats)
+      : d_(d), ev_(ev), nx_(d.num_states), nq_(d.num_quadratures), ns_(ns), stats_(stats),
+        jac_(nx_, nx_), identity_(Matrix::Identity(nx_, nx_)) {}
+
+  /// J = df/dx at (t, y) from one tangent pass with the identity as state seeds.
+  void jacobian(double t, const Vector& y) {
+    ev_.tangents(t, y.data(), nx_, {identity_.data(), nx_}, false, {jac_.data(), nx_}, {});
+    ++stats_.jac_evals;
+  }
+  void factor(double hg) {
+    lu_.compute(identity_ - hg * jac_);
+    factored_hg_ = hg;
+  }
+
+  Vector f(double t, const Vector& y) {
+    Vector out(std::max(nx_, 1));
+    out.setZero();
+    evaluate(t, [&] { ev_.derivatives(t, y.data(), out.data()); });
+    ++stats_.rhs_evals;
+    if (!ev_.all_finite(out.data())) {
+      const std::string bad = ev_.find_nonfinite(out.data());
+      throw SolverError(t, bad.substr(0, bad.find(':')), bad.substr(bad.find(':') + 2));
+    }
+    return out.head(nx_);
+  }
+  Vector g(double t, const Vector& y) {
+    Vector out(std::max(nq_, 1));
+    out.setZero();
+    if (nq_ > 0) evaluate(t, [&] { ev_.quadratures(t, y.data(), out.data()); });
+    return out.head(nq_);
+  }
+
+  /// Solves Y - hg f(t, Y) = rhs by Newton's method from the guess Y = rhs, with the current
+  /// Jacobian; converged to rounding level so the sensitivities below are those of the map.
+  Vector solve_stage(double t, double hg, const Vector& rhs) {
+    if (hg != factored_hg_) factor(hg);
+    Vector y = rhs;
+    for (int it = 0; it < 12; ++it) {
+      const Vector residual = y - hg * f(t, y) - rhs;
+      const Vector delta = lu_.solve(residual);
+      y -= delta;
+      ++stats_.nonlinear_iterations;
+      const double scale = 1.0 + y.cwiseAbs().maxCoeff();
+      if (!std::isfinite(delta.squaredNorm()))
+        throw SolverError(t, "", "Newton iteration diverged (non-finite iterate)");
+      if (delta.cwiseAbs().maxCoeff() <= 1e-13 * scale) return y;
+      if (it >= 3) {  // slow: refresh the Jacobian at the current iterate
+        jacobian(t, y);
+        factor(hg);
+      }
+    }
+    throw SolverError(t, "", "Newton iteration did not converge in 12 iterations (step " +
+                                 std::to_string(hg / kGamma) + " s too large?)");
+  }
+
+  /// Stage sensitivity: (I - hg J(Y)) dY = rhs + hg f_p(Y), with J refreshed at Y. Returns dY
+  /// and fills dk = f_x dY + f_p and dq = g_x dY + g_p.
+  Matrix stage_sensitivity(double t, double hg, const Vector& y, const Matrix& rhs, Matrix& dk,
+                           Matrix& dq) {
+    jacobian(t, y);
+    factor(hg);
+    Matrix fp(nx_, ns_), qp(std::max(nq_, 1), ns_);
+    fp.setZero();
+    qp.setZero();
+    evaluate(t, [&] {
+      ev_.tangents(t, y.data(), ns_, {}, true, {fp.data(), nx_}, {nq_ ? qp.data() : nullptr, nq_});
+    });
+    const Matrix dy = lu_.solve(rhs + hg * fp);
+    dk.resize(nx_, ns_);
+    dq.resize(std::max(nq_, 1), ns_);
+    dq.setZero();
+    evaluate(t, [&] {
+      ev_.tangents(t, y.data(), ns_, {dy.data(), nx_}, true, {dk.data(), nx_}, {nq_ ? dq.data() : nullptr, nq_});
+    });
+    ++stats_.sens_rhs_evals;
+    return dy;
+  }
+
+ private:
+  template <class F>
+  void evaluate(double t, F&& call) {
+    try {
+      call();
+    } catch (const OutOfDomain& e) {
+      throw SolverError(t, "", "input out of a block's domain: " + e.reason);
+    }
+  }
+
+  const Diagram& d_;
+  Evaluator& ev_;
+  int nx_, nq_, ns_;
+  RunStats& stats_;
+  Matrix jac_, identity_;
+  Eigen::PartialPivLU<Matrix> lu_;
+  double factored_hg_ = -1.0;
+};
+
+}  // namespace
+
+RunResult run_sdirk(const Diagram& d, const RunOptions& options) {
+  const int nx = d.num_states, nq = d.num_quadratures;
+  const int ns = options.sensitivities ? static_cast<int>(d.sensitivities.size()) : 0;
+  const double t0 = d.time.start, tf = d.time.stop;
+  const double h_max = d.solver.step > 0 ? d.solver.step : d.time.output_step / 10.0;
+
+  Evaluator ev(d, ns > 0);
+  RunResult result;
+  Recorder recorder(d, ns, result);
+  RunStats& st = result.stats;
+  const CpuClock clock;
+  Stepper stepper(d, ev, ns, st);
+
+  Vector x(std::max(nx, 1)), q = Vector::Zero(nq);
+  x.setZero();
+  ev.set_segment_start(t0);
+  ev.initial_state(t0, x.data());
+  x.conservativeResize(nx);
+  Matrix S = Matrix::Zero(nx, ns), Sq = Matrix::Zero(std::max(nq, 1), ns);
+  if (ns > 0) ev.initial_state_tangent(t0, x.data(), {S.data(), nx});
+
+  auto record = [&](double t) {
+    if (ns > 0) ev.tangents(t, x.data(), ns, {S.data(), nx}, true, {}, {});
+    else ev.outputs(t, x.data());
+    recorder.record(t, x.data(), ev);
+    if (options.progress) options.progress(t);
+  };
+  record(t0);
+
+  const std::vector<double> outputs = output_grid(d.time);
+  const std::vector<double> breaks = d.breakpoints(t0, tf);
+  std::vector<double> events(outputs.begin() + 1, outputs.end());
+  events.insert(events.end(), breaks.begin(), breaks.end());
+  std::sort(events.begin(), events.end());
+  events.erase(std::unique(events.begin(), events.end()), events.end());
+
+  double t = t0;
+  size_t next_output = 1;
+  if (nx > 0) stepper.jacobian(t0, x);
+  for (double target : events) {
+    const long n = std::max(1L, std::lround(std::ceil((target - t) / h_max - 1e-9)));
+    const double h = (target - t) / n, hg = kGamma * h;
+    for (long step = 0; step < n; ++step) {
+      const double tn = t + step * h, t1 = tn + hg, t2 = tn + h;
+      // Y1 = x + h g f(Y1);  Y2 = x + h (1 - g) f(Y1) + h g f(Y2);  x+ = Y2.
+      const Vector y1 = nx ? stepper.solve_stage(t1, hg, x) : x;
+      const Vector k1 = stepper.f(t1, y1);
+      const Vector q1 = stepper.g(t1, y1);
+      Matrix dk1, dq1;
+      Matrix dy1 = ns ? stepper.stage_sensitivity(t1, hg, y1, S, dk1, dq1) : Matrix();
+      const Vector rhs2 = x + h * (1 - kGamma) * k1;
+      const Vector y2 = nx ? stepper.solve_stage(t2, hg, rhs2) : x;
+      const Vector q2 = stepper.g(t2, y2);
+      if (ns > 0) {
+        Matrix dk2, dq2;
+        const Matrix dy2 = stepper.stage_sensitivity(t2, hg, y2, S + h * (1 - kGamma) * dk1, dk2, dq2);
+        S = dy2;
+        if (nq > 0) Sq.topRows(nq) += h * ((1 - kGamma) * dq1.topRows(nq) + kGamma * dq2.topRows(nq));
+      }
+      if (nq > 0) q += h * ((1 - kGamma) * q1 + kGamma * q2);
+      x = y2;
+      ++st.steps;
+    }
+    t = target;
+    if (next_output < outputs.size() && outputs[next_output] == target) {
+      record(target);
+      ++next_output;
+    }
+    if (std::binary_search(breaks.begin(), breaks.end(), target)) ev.set_segment_start(target);
+  }
+  Vector qf = Vector::Zero(std::max(nq, 1));
+  qf.head(nq) = q;
+  recorder.finish(qf.data(), {Sq.data(), static_cast<int>(Sq.rows())});
+  result.final_state.assign(x.data(), x.data() + nx);
+
+  st.method = "sdirk2";
+  st.step = h_max;
+  st.cpu_seconds = clock.seconds();
+  st.simulated_seconds = tf - t0;
+  st.realtime_factor = st.cpu_seconds > 0 ? st.simulated_seconds / st.cpu_seconds : 0.0;
+  return result;
+}
+
+}  // namespace dydp::engine
