@@ -26,7 +26,15 @@ struct SweepArgs {
   bool report = false;
 };
 
+struct AccuracyArgs {
+  std::string scene;
+  std::string out = "out";
+  std::vector<std::string> sets;
+  double target = 1e-4;  ///< requested relative accuracy for the "cheapest setting" line
+};
+
 int run_command(const RunArgs& args);
+int accuracy_command(const AccuracyArgs& args);
 int sweep_command(const SweepArgs& args);
 int blocks_command(std::ostream& out);
 

@@ -32,6 +32,13 @@ int main(int argc, char** argv) {
   sweep->add_option("--delta", sweep_args.delta, "report the change of psi for this step of the parameter");
   sweep->add_flag("--report", sweep_args.report, "also write plots (gnuplot) and report.md");
 
+  dydp::apps::AccuracyArgs accuracy_args;
+  CLI::App* accuracy = app.add_subcommand("accuracy", "Error against run time over solvers and tolerances");
+  accuracy->add_option("scene", accuracy_args.scene, "scene file (YAML)")->required();
+  accuracy->add_option("--out", accuracy_args.out, "output folder")->capture_default_str();
+  accuracy->add_option("--set", accuracy_args.sets, "override a scene parameter: NAME=VALUE");
+  accuracy->add_option("--target", accuracy_args.target, "accuracy for the cheapest-setting line")->capture_default_str();
+
   CLI::App* blocks = app.add_subcommand("blocks", "List the block types with ports and parameters");
 
   try {
@@ -44,6 +51,7 @@ int main(int argc, char** argv) {
   try {
     if (*run) return dydp::apps::run_command(run_args);
     if (*sweep) return dydp::apps::sweep_command(sweep_args);
+    if (*accuracy) return dydp::apps::accuracy_command(accuracy_args);
     if (*blocks) return dydp::apps::blocks_command(std::cout);
   } catch (const dydp::engine::InputError& e) {
     std::cerr << e.what() << "\n";
