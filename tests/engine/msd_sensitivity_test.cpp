@@ -8,6 +8,8 @@
 #include <fstream>
 #include <numbers>
 
+#include <unistd.h>
+
 #include "engine/diagram.hpp"
 #include "engine/run.hpp"
 #include "tests/engine/msd_closed_form.hpp"
@@ -39,9 +41,9 @@ outputs: [body.x, x_rms]
 }
 
 Diagram load(const std::string& solver) {
-  const auto dir = std::filesystem::temp_directory_path() / "dydp_msd_test";
-  std::filesystem::create_directories(dir);
-  const auto path = dir / "msd.yaml";
+  // One file per process: ctest runs the tests of this binary in parallel processes.
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("dydp_msd_test_" + std::to_string(::getpid()) + ".yaml");
   std::ofstream(path) << scene_text(solver);
   return load_scene(path.string());
 }

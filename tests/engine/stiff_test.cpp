@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <unistd.h>
+
 #include "engine/diagram.hpp"
 #include "engine/errors.hpp"
 #include "engine/run.hpp"
@@ -15,7 +17,8 @@ namespace dydp::engine {
 namespace {
 
 Diagram stiff_scene(const std::string& solver) {
-  const auto path = std::filesystem::temp_directory_path() / "dydp_stiff_test.yaml";
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("dydp_stiff_test_" + std::to_string(::getpid()) + ".yaml");
   std::ofstream(path) << R"(scene: stiff
 time: {start: 0.0, stop: 2.0, output_step: 0.01}
 solver: )" << solver << R"(
