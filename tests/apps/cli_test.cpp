@@ -426,3 +426,47 @@ TEST_F(Cli, BlocksListsEveryRegisteredType) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------- sweep and accuracy
+
+TEST_F(Cli, SweepReportsExactDerivativesThatCentralDifferencesApproach) {
+  const fs::path out = dir_ / "sweep";
+  const Result r = dydp("sweep " + quote(msd_scene()) + " --param damping --range 0.5:2.5:3 --fd 0.1,0.001 --delta 0.1 --out " +
+                        quote(out.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(read_text(out / "sweep.json"));
+  ASSERT_EQ(j["points"].size(), 3u);
+  EXPECT_DOUBLE_EQ(j["points"][1]["p"].get<double>(), 1.5);
+  for (const auto& pt : j["points"]) {
+    const auto& o = pt["objectives"]["x_rms"];
+    const double exact = o["sensitivity"].get<double>();
+    const double fd_coarse = o["fd"][0]["value"].get<double>(), fd_fine = o["fd"][1]["value"].get<double>();
+    // More damping, less motion; the finer difference is closer to the exact derivative.
+    EXPECT_LT(exact, 0.0);
+    EXPECT_LT(std::fabs(fd_fine - exact), std::fabs(fd_coarse - exact));
+    EXPECT_LT(std::fabs(fd_fine - exact), 1e-4 * std::fabs(exact));
+    EXPECT_NEAR(o["normalised"].get<double>(), pt["p"].get<double>() / o["value"].get<double>() * exact, 1e-12);
+  }
+  const auto rows = split(read_text(out / "sweep.csv"), '\n');
+  EXPECT_EQ(rows.size(), 4u);  // header + 3 points
+}
+
+TEST_F(Cli, SweepOfAnUnknownParameterExitsTwo) {
+  const Result r = dydp("sweep " + quote(msd_scene()) + " --param nope --range 0:1:3 --out " + quote((dir_ / "o").string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("nope"), std::string::npos) << r.err;
+  const Result bad_range = dydp("sweep " + quote(msd_scene()) + " --param damping --range 1:0 --out " + quote((dir_ / "o").string()));
+  EXPECT_EQ(bad_range.status, 2);
+  EXPECT_NE(bad_range.err.find("LO:HI:N"), std::string::npos) << bad_range.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o" / "sweep.csv"));
+}
+
+TEST_F(Cli, AccuracyWritesTheLadderAndNamesTheCheapestSetting) {
+  const fs::path out = dir_ / "acc";
+  const Result r = dydp("accuracy " + quote(msd_scene()) + " --target 1e-5 --out " + quote(out.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = split(read_text(out / "accuracy.csv"), '\n');
+  EXPECT_EQ(rows.size(), 1u + 7 + 7 + 6 + 6);
+  EXPECT_NE(r.out.find("Cheapest setting for errors below 1e-05"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(out / "accuracy.md"));
+}
