@@ -176,7 +176,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
 
   Evaluator ev(d, ns > 0);
   RunResult result;
-  Recorder recorder(d, ns, result);
+  Recorder recorder(d, ns, result, options);
   Problem P{d, ev, nx, ns, {}, {}, {}, {}, 0.0, {}, 0, 0};
   P.identity.assign(static_cast<size_t>(nx) * nx, 0.0);
   for (int i = 0; i < nx; ++i) P.identity[i * nx + i] = 1.0;
@@ -273,7 +273,6 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
       ev.outputs(t, NV_DATA_S(S.y));
     }
     recorder.record(t, NV_DATA_S(S.y), ev);
-    if (options.progress) options.progress(t);
   };
   record(t0);
 

@@ -93,8 +93,11 @@ class Diagram {
   std::vector<double> breakpoints(double t0, double t1) const;
 };
 
-/// Loads a scene file; overrides are --set NAME=VALUE pairs. Throws InputError on bad input.
+/// Loads a scene file; overrides are --set NAME=VALUE pairs for scene parameters;
+/// setting_overrides (SETTING, VALUE) replace that setting in every block whose type declares
+/// it (replay: the recorded input file). Throws InputError on bad input.
 Diagram load_scene(const std::string& path,
-                   const std::vector<std::pair<std::string, std::string>>& overrides = {});
+                   const std::vector<std::pair<std::string, std::string>>& overrides = {},
+                   const std::vector<std::pair<std::string, std::string>>& setting_overrides = {});
 
 }  // namespace dydp::engine

@@ -6,8 +6,8 @@
 
 namespace dydp::engine {
 
-Recorder::Recorder(const Diagram& d, int directions, RunResult& result)
-    : d_(d), ns_(directions), result_(result), samples_(d.objectives.size()) {
+Recorder::Recorder(const Diagram& d, int directions, RunResult& result, const RunOptions& options)
+    : d_(d), ns_(directions), result_(result), options_(options), samples_(d.objectives.size()) {
   for (const LoggedSignal& s : d.logged) result_.signal_names.push_back(s.name);
   for (int dir = 0; dir < ns_; ++dir)
     result_.sensitivity_names.push_back(d.parameters[d.sensitivities[dir]].name);
@@ -43,6 +43,8 @@ void Recorder::record(double t, const double* x, Evaluator& ev) {
     for (int dir = 0; dir < ns_; ++dir)
       for (int c = 0; c < w; ++c) s.du.push_back(dsig[dir * nsig + src + c]);
   }
+  if (options_.on_sample) options_.on_sample(result_);
+  if (options_.progress) options_.progress(t);
 }
 
 void Recorder::finish(const double* q, ConstDirView dq) {

@@ -11,10 +11,11 @@ namespace dydp::engine {
 
 class Recorder {
  public:
-  Recorder(const Diagram& d, int directions, RunResult& result);
+  Recorder(const Diagram& d, int directions, RunResult& result, const RunOptions& options);
 
   /// Records time t; the evaluator holds the value pass and, with directions, the tangent pass
-  /// at (t, x, dx/dp). Throws SolverError when a state or output is not finite.
+  /// at (t, x, dx/dp). Throws SolverError when a state or output is not finite. Then calls the
+  /// options' on_sample and progress callbacks.
   void record(double t, const double* x, Evaluator& ev);
 
   /// Objectives from the quadratures q and their sensitivities dq (ld = num_quadratures).
@@ -24,6 +25,7 @@ class Recorder {
   const Diagram& d_;
   int ns_;
   RunResult& result_;
+  const RunOptions& options_;
   struct Sampled {
     std::vector<double> t, u, du;
   };

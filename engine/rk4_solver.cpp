@@ -26,7 +26,7 @@ RunResult run_rk4(const Diagram& d, const RunOptions& options) {
 
   Evaluator ev(d, ns > 0);
   RunResult result;
-  Recorder recorder(d, ns, result);
+  Recorder recorder(d, ns, result, options);
   RunStats& st = result.stats;
   const CpuClock clock;
 
@@ -76,7 +76,6 @@ RunResult run_rk4(const Diagram& d, const RunOptions& options) {
     if (ns > 0) ev.tangents(t, s.x.data(), ns, {s.dx.data(), nx}, true, {}, {});
     else ev.outputs(t, s.x.data());
     recorder.record(t, s.x.data(), ev);
-    if (options.progress) options.progress(t);
   };
   record(t0);
 

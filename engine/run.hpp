@@ -10,9 +10,14 @@
 
 namespace dydp::engine {
 
+struct RunResult;
+
 struct RunOptions {
   bool sensitivities = true;                  ///< false: --no-sens, no tangent work at all
   std::function<void(double t)> progress;     ///< called at every output time
+  /// Called at every output time with the result so far (its last sample is the new one):
+  /// for streaming outputs. An exception thrown here ends the run.
+  std::function<void(const RunResult&)> on_sample;
 };
 
 struct RunStats {

@@ -124,7 +124,7 @@ void read_parameters(const SceneReader& r, const YAML::Node& n, Diagram& d) {
 
 /// One block of the scene: parameters resolved, settings collected, instance made.
 Node read_block(const SceneReader& r, const YAML::Node& key, const YAML::Node& body,
-                const Diagram& d) {
+                const Diagram& d, const std::vector<std::pair<std::string, std::string>>& forced) {
   Node node;
   node.name = key.Scalar();
   node.line = line_of(key);
@@ -166,6 +166,10 @@ Node read_block(const SceneReader& r, const YAML::Node& key, const YAML::Node& b
       settings.set(k, std::move(v));
     }
   }
+  for (const auto& [name, value] : forced)
+    if (std::any_of(type.settings.begin(), type.settings.end(),
+                    [&](const SettingSpec& s) { return s.name == name; }))
+      settings.set(name, {{value}, false, node.line});
   for (const SettingSpec& s : type.settings) {
     if (settings.has(s.name)) continue;
     if (s.required) r.fail(key, node.name + "." + s.name, "required setting is missing");
@@ -207,7 +211,8 @@ Node read_block(const SceneReader& r, const YAML::Node& key, const YAML::Node& b
 }  // namespace
 
 Diagram load_scene(const std::string& path,
-                   const std::vector<std::pair<std::string, std::string>>& overrides) {
+                   const std::vector<std::pair<std::string, std::string>>& overrides,
+                   const std::vector<std::pair<std::string, std::string>>& setting_overrides) {
   SceneReader r(path);
   YAML::Node root;
   try {
@@ -258,7 +263,7 @@ Diagram load_scene(const std::string& path,
   GraphBuilder graph(path);
   for (auto kv : blocks) {
     if (graph.has_block(kv.first.Scalar())) r.fail(kv.first, kv.first.Scalar(), "block defined twice");
-    graph.add_block(read_block(r, kv.first, kv.second, d));
+    graph.add_block(read_block(r, kv.first, kv.second, d, setting_overrides));
   }
 
   // Sensitivity directions must only reach parameters the blocks can differentiate.

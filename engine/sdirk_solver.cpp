@@ -127,7 +127,7 @@ RunResult run_sdirk(const Diagram& d, const RunOptions& options) {
 
   Evaluator ev(d, ns > 0);
   RunResult result;
-  Recorder recorder(d, ns, result);
+  Recorder recorder(d, ns, result, options);
   RunStats& st = result.stats;
   const CpuClock clock;
   Stepper stepper(d, ev, ns, st);
@@ -144,7 +144,6 @@ RunResult run_sdirk(const Diagram& d, const RunOptions& options) {
     if (ns > 0) ev.tangents(t, x.data(), ns, {S.data(), nx}, true, {}, {});
     else ev.outputs(t, x.data());
     recorder.record(t, x.data(), ev);
-    if (options.progress) options.progress(t);
   };
   record(t0);
 

@@ -33,7 +33,17 @@ struct AccuracyArgs {
   double target = 1e-4;  ///< requested relative accuracy for the "cheapest setting" line
 };
 
+struct ReplayArgs {
+  std::string scene;
+  std::string input;              ///< recorded CSV: t, one column per pad, measured responses
+  std::string out = "out";
+  std::vector<std::string> sets;
+  bool realtime = false;          ///< pace to the wall clock
+  bool no_sens = false;
+};
+
 int run_command(const RunArgs& args);
+int replay_command(const ReplayArgs& args);
 int accuracy_command(const AccuracyArgs& args);
 int sweep_command(const SweepArgs& args);
 int blocks_command(std::ostream& out);

@@ -39,6 +39,15 @@ int main(int argc, char** argv) {
   accuracy->add_option("--set", accuracy_args.sets, "override a scene parameter: NAME=VALUE");
   accuracy->add_option("--target", accuracy_args.target, "accuracy for the cheapest-setting line")->capture_default_str();
 
+  dydp::apps::ReplayArgs replay_args;
+  CLI::App* replay = app.add_subcommand("replay", "Replay recorded test-bench input through a scene");
+  replay->add_option("scene", replay_args.scene, "scene file (YAML)")->required();
+  replay->add_option("--input", replay_args.input, "recorded CSV: t, one column per pad (named in the scene), measured outputs")->required();
+  replay->add_option("--out", replay_args.out, "output folder")->capture_default_str();
+  replay->add_option("--set", replay_args.sets, "override a scene parameter: NAME=VALUE");
+  replay->add_flag("--realtime", replay_args.realtime, "pace the run to the wall clock and report missed deadlines");
+  replay->add_flag("--no-sens", replay_args.no_sens, "run without sensitivities");
+
   CLI::App* blocks = app.add_subcommand("blocks", "List the block types with ports and parameters");
 
   try {
@@ -52,6 +61,7 @@ int main(int argc, char** argv) {
     if (*run) return dydp::apps::run_command(run_args);
     if (*sweep) return dydp::apps::sweep_command(sweep_args);
     if (*accuracy) return dydp::apps::accuracy_command(accuracy_args);
+    if (*replay) return dydp::apps::replay_command(replay_args);
     if (*blocks) return dydp::apps::blocks_command(std::cout);
   } catch (const dydp::engine::InputError& e) {
     std::cerr << e.what() << "\n";

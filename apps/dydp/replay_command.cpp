@@ -1,0 +1,178 @@
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "apps/dydp/commands.hpp"
+#include "engine/errors.hpp"
+#include "engine/output_writer.hpp"
+#include "engine/run.hpp"
+
+namespace dydp::apps {
+namespace {
+
+/// The columns of a CSV file with a header line: name -> values.
+struct Csv {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> columns;
+};
+
+Csv read_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw engine::InputError(path, 0, "--input", "cannot open the recorded input");
+  Csv csv;
+  std::string line;
+  std::getline(in, line);
+  std::stringstream header(line);
+  for (std::string cell; std::getline(header, cell, ',');) {
+    cell.erase(0, cell.find_first_not_of(" \t\r"));
+    cell.erase(cell.find_last_not_of(" \t\r") + 1);
+    csv.names.push_back(cell);
+  }
+  csv.columns.resize(csv.names.size());
+  for (int row = 2; std::getline(in, line); ++row) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::stringstream ss(line);
+    size_t c = 0;
+    for (std::string cell; std::getline(ss, cell, ','); ++c) {
+      double v = 0;
+      cell.erase(cell.find_last_not_of(" \t\r") + 1);
+      if (c >= csv.names.size() || !engine::parse_number(cell, v))
+        throw engine::InputError(path, row, c < csv.names.size() ? csv.names[c] : "", "malformed value '" + cell + "'");
+      csv.columns[c].push_back(v);
+    }
+    if (c != csv.names.size()) throw engine::InputError(path, row, "", "expected " + std::to_string(csv.names.size()) + " values");
+  }
+  return csv;
+}
+
+double interpolate(const std::vector<double>& t, const std::vector<double>& y, double x) {
+  if (x <= t.front()) return y.front();
+  if (x >= t.back()) return y.back();
+  const size_t k = std::upper_bound(t.begin(), t.end(), x) - t.begin();
+  const double w = (x - t[k - 1]) / (t[k] - t[k - 1]);
+  return (1 - w) * y[k - 1] + w * y[k];
+}
+
+/// One CSV line per output sample, appended and flushed as the run goes.
+class StreamingCsv {
+ public:
+  explicit StreamingCsv(std::string path) : path_(std::move(path)), partial_(path_ + ".partial") {}
+  ~StreamingCsv() {
+    if (!done_) std::remove(partial_.c_str());
+  }
+  void sample(const engine::RunResult& r) {
+    if (!out_.is_open()) {
+      out_.open(partial_, std::ios::trunc);
+      if (!out_) throw std::runtime_error("cannot write " + partial_);
+      out_.precision(12);
+      out_ << "t";
+      for (const auto& s : r.signal_names) out_ << ',' << s;
+      for (const auto& p : r.sensitivity_names)
+        for (const auto& s : r.signal_names) out_ << ",d(" << s << ")/d(" << p << ')';
+      out_ << '\n';
+    }
+    const int k = static_cast<int>(r.t.size()) - 1, nsig = r.num_signals();
+    out_ << r.t[k];
+    for (int i = 0; i < nsig; ++i) out_ << ',' << r.value(k, i);
+    for (size_t d = 0; d < r.sensitivity_names.size(); ++d)
+      for (int i = 0; i < nsig; ++i) out_ << ',' << r.tangent(k, static_cast<int>(d), i);
+    out_ << '\n';
+    out_.flush();
+  }
+  void finish() {
+    out_.close();
+    std::filesystem::rename(partial_, path_);
+    done_ = true;
+  }
+
+ private:
+  std::string path_, partial_;
+  std::ofstream out_;
+  bool done_ = false;
+};
+
+}  // namespace
+
+int replay_command(const ReplayArgs& args) {
+  const Csv recorded = read_csv(args.input);
+  if (recorded.names.empty() || recorded.names[0] != "t")
+    throw engine::InputError(args.input, 1, "t", "the first column must be the time t [s]");
+  const std::string input = std::filesystem::absolute(args.input).string();
+  engine::Diagram d = engine::load_scene(args.scene, parse_sets(args.sets), {{"input_file", input}});
+  bool takes_input = false;
+  for (const auto& n : d.nodes)
+    for (const auto& s : n.type->settings) takes_input = takes_input || s.name == "input_file";
+  if (!takes_input)
+    throw engine::InputError(args.scene, 0, "blocks",
+                             "no block of this scene takes recorded input (a block with an `input_file` "
+                             "setting, such as road.fourposter)");
+
+  std::filesystem::create_directories(args.out);
+  StreamingCsv stream(args.out + "/signals.csv");
+  engine::RunOptions options;
+  options.sensitivities = !args.no_sens;
+  long missed = 0;
+  double worst_lag = 0;
+  const auto wall_start = std::chrono::steady_clock::now();
+  options.on_sample = [&](const engine::RunResult& r) {
+    stream.sample(r);
+    if (!args.realtime) return;
+    // Paced to the wall clock: wait for the sample's time; a sample made later than one output
+    // step after its time is a missed deadline.
+    const double due = r.t.back() - d.time.start;
+    const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    if (now < due) std::this_thread::sleep_for(std::chrono::duration<double>(due - now));
+    else if (now - due > d.time.output_step) ++missed;
+    worst_lag = std::max(worst_lag, now - due);
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  const engine::RunResult r = engine::run(d, options);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stream.finish();
+  engine::write_file_atomically(args.out + "/objectives.json", engine::objectives_json(r));
+  engine::write_file_atomically(args.out + "/run.json", engine::run_json(d, r));
+
+  // Measured responses: columns named after logged signals.
+  nlohmann::ordered_json j = {{"input", args.input}, {"simulated_seconds", r.stats.simulated_seconds},
+                              {"cpu_seconds", r.stats.cpu_seconds}, {"wall_seconds", wall},
+                              {"realtime_factor", r.stats.realtime_factor}, {"paced", args.realtime}};
+  if (args.realtime) j["missed_deadlines"] = missed, j["worst_lag_seconds"] = worst_lag;
+  std::cout << std::setprecision(4) << d.scene_name << " replay of " << args.input << ": "
+            << r.stats.simulated_seconds << " s simulated in " << r.stats.cpu_seconds << " CPU s ("
+            << r.stats.realtime_factor << "x real time)";
+  if (args.realtime) std::cout << ", paced: " << missed << " missed deadlines";
+  std::cout << "\n";
+  j["validation"] = nlohmann::ordered_json::object();
+  for (size_t c = 1; c < recorded.names.size(); ++c) {
+    const int i = r.signal_index(recorded.names[c]);
+    if (i < 0) continue;
+    double se = 0, sm = 0, ss = 0, smm = 0, sss = 0, sms = 0;
+    const size_t n = r.t.size();
+    for (size_t k = 0; k < n; ++k) {
+      const double meas = interpolate(recorded.columns[0], recorded.columns[c], r.t[k]);
+      const double sim = r.value(static_cast<int>(k), i);
+      se += (sim - meas) * (sim - meas);
+      sm += meas, ss += sim, smm += meas * meas, sss += sim * sim, sms += meas * sim;
+    }
+    const double cov = sms / n - sm / n * ss / n;
+    const double var_m = smm / n - sm / n * sm / n, var_s = sss / n - ss / n * ss / n;
+    const double corr = var_m > 0 && var_s > 0 ? cov / std::sqrt(var_m * var_s) : 0.0;
+    const double rms = std::sqrt(se / n);
+    j["validation"][recorded.names[c]] = {{"rms_error", rms}, {"correlation", corr}, {"samples", n}};
+    std::cout << "  " << recorded.names[c] << ": rms error " << rms << ", correlation " << corr << "\n";
+  }
+  engine::write_file_atomically(args.out + "/replay.json", j.dump(2) + "\n");
+  std::cout << "  results in " << args.out << "/ (signals.csv streamed, objectives.json, run.json, replay.json)\n";
+  return 0;
+}
+
+}  // namespace dydp::apps
