@@ -68,7 +68,7 @@ std::vector<FunctionStats> generate(const GenerationInput& input, const Generati
   return stats;
 }
 
-std::string stats_json(const std::vector<FunctionStats>& functions, double seconds) {
+std::string stats_json(const std::vector<FunctionStats>& functions, double seconds, std::size_t scheme_assignments) {
   std::ostringstream s;
   s << "{\n  \"functions\": {";
   for (std::size_t i = 0; i < functions.size(); ++i) {
@@ -79,7 +79,9 @@ std::string stats_json(const std::vector<FunctionStats>& functions, double secon
       << "}, \"ops_total\": " << f.ops.total() << "}";
   }
   s.precision(6);
-  s << "\n  },\n  \"seconds\": " << std::fixed << seconds << "\n}\n";
+  s << "\n  },\n";
+  if (scheme_assignments) s << "  \"scheme_assignments\": " << scheme_assignments << ",\n";
+  s << "  \"seconds\": " << std::fixed << seconds << "\n}\n";
   return s.str();
 }
 

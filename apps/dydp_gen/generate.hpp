@@ -36,7 +36,9 @@ struct GenerationOptions {
 std::vector<FunctionStats> generate(const GenerationInput& input, const GenerationOptions& options);
 
 // stats.json as in the CLI contract of docs (DESIGN.md, section 5).
-std::string stats_json(const std::vector<FunctionStats>& functions, double seconds);
+// `scheme_assignments` (multibody models): the whole recursive scheme before elimination.
+std::string stats_json(const std::vector<FunctionStats>& functions, double seconds,
+                       std::size_t scheme_assignments = 0);
 
 // Writes `text` to `path` through a temporary file in the same folder, then renames it.
 void write_atomically(const std::filesystem::path& path, const std::string& text);

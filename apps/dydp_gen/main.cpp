@@ -1,5 +1,5 @@
 // dydp-gen: generates C++ (a function and its tangent) from one model description.
-// Front ends by extension: `.eqs` equation lists now; `.mbs.yaml` multibody models later.
+// Front ends by extension: `.eqs` equation lists and `.mbs.yaml` multibody models.
 // Exit status: 0 success, 2 bad input (`file:line: message` on stderr), 1 other failure.
 #include <CLI/CLI.hpp>
 
@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "generate.hpp"
+#include "generate_mbs.hpp"
 #include "symbolic/eqs_reader.hpp"
 
 namespace {
@@ -31,7 +32,7 @@ int main(int argc, char** argv) {
   std::string out_dir;
   bool stats = false;
   bool expand = false;
-  app.add_option("MODEL", model_path, "model file (.eqs equation list)")->required();
+  app.add_option("MODEL", model_path, "model file (.eqs equation list or .mbs.yaml multibody model)")->required();
   app.add_option("--out", out_dir, "output folder for NAME.hpp, NAME.cpp (and stats.json)")->required();
   app.add_flag("--stats", stats, "also write OUT/stats.json (equations and operation counts)");
   app.add_flag("--expand", expand, "emit the in-extenso (non-recursive) form instead");
@@ -45,11 +46,19 @@ int main(int argc, char** argv) {
   const auto start = std::chrono::steady_clock::now();
   try {
     if (ends_with(model_path, ".mbs.yaml")) {
-      std::cerr << model_path << ":0: multibody models (.mbs.yaml) are not supported by this version\n";
-      return 2;
+      const dydp::gen::MbsGeneration g = dydp::gen::generate_mbs(model_path, {out_dir, expand});
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (!g.independent.empty()) {
+        std::cout << "independent coordinates" << (g.independent_automatic ? " (automatic):" : ":");
+        for (const auto& u : g.independent) std::cout << " " << u;
+        std::cout << "\n";
+      }
+      if (stats) dydp::gen::write_atomically(std::filesystem::path(out_dir) / "stats.json",
+                                             dydp::gen::stats_json(g.functions, seconds, g.scheme_assignments));
+      return 0;
     }
     if (!ends_with(model_path, ".eqs")) {
-      std::cerr << model_path << ":0: unknown model format (expected .eqs)\n";
+      std::cerr << model_path << ":0: unknown model format (expected .eqs or .mbs.yaml)\n";
       return 2;
     }
     const dydp::symbolic::EqsModel model = dydp::symbolic::read_eqs(model_path);

@@ -1,0 +1,178 @@
+// dydp-gen for multibody models (see generate_mbs.hpp).
+#include "generate_mbs.hpp"
+
+#include <Eigen/Dense>
+#include <sstream>
+
+#include "symbolic/differentiate.hpp"
+#include "symbolic/eliminate.hpp"
+#include "symbolic/emit_cpp.hpp"
+#include "symbolic/expand.hpp"
+#include "symbolic/mbs/model.hpp"
+#include "symbolic/mbs/newton_euler.hpp"
+#include "symbolic/mbs/numeric_dynamics.hpp"
+
+namespace dydp::gen {
+namespace {
+
+using namespace dydp::symbolic;
+
+std::string string_array(const std::string& name, const std::vector<std::string>& items) {
+  std::string s = "const char* const " + name + "[] = {";
+  for (const auto& i : items) s += "\"" + i + "\", ";
+  if (items.empty()) s += "nullptr";
+  return s + "};\n";
+}
+
+template <class T>
+std::string number_array(const std::string& type, const std::string& name, const std::vector<T>& items) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "const " << type << " " << name << "[] = {";
+  for (const auto& i : items) s << i << ", ";
+  if (items.empty()) s << "0";
+  s << "};\n";
+  return s.str();
+}
+
+// Independent coordinates: the model's, or the columns a pivoted QR of J (free columns, at the
+// initial configuration) leaves after picking the m best conditioned dependent ones.
+std::vector<int> choose_independent(const mbs::Model& model, bool& automatic) {
+  automatic = false;
+  if (!model.independent.empty() || model.constraint_count() == 0) {
+    if (!model.independent.empty()) return model.independent;
+    std::vector<int> u;
+    for (int j = 0; j < model.coordinates(); ++j)
+      if (!model.joints[j].driven) u.push_back(j);
+    return u;
+  }
+  automatic = true;
+  mbs::NumericDynamics numeric(model);
+  Eigen::VectorXd q0(model.coordinates());
+  for (int j = 0; j < model.coordinates(); ++j) q0[j] = model.joints[j].initial;
+  const Eigen::MatrixXd J = numeric.constraint_jacobian(q0);
+  std::vector<int> free;
+  for (int j = 0; j < model.coordinates(); ++j)
+    if (!model.joints[j].driven) free.push_back(j);
+  Eigen::MatrixXd Jf(J.rows(), static_cast<Eigen::Index>(free.size()));
+  for (std::size_t i = 0; i < free.size(); ++i) Jf.col(i) = J.col(free[i]);
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Jf);
+  if (qr.rank() < J.rows())
+    throw std::runtime_error(model.file + ": the constraint Jacobian has rank " + std::to_string(qr.rank()) +
+                             " < " + std::to_string(J.rows()) + " constraints at the initial configuration");
+  std::vector<bool> dependent(free.size(), false);
+  for (Eigen::Index i = 0; i < J.rows(); ++i) dependent[qr.colsPermutation().indices()[i]] = true;
+  std::vector<int> u;
+  for (std::size_t i = 0; i < free.size(); ++i)
+    if (!dependent[i]) u.push_back(free[i]);
+  return u;
+}
+
+}  // namespace
+
+MbsGeneration generate_mbs(const std::string& model_path, const GenerationOptions& options) {
+  const mbs::Model model = mbs::load_model(model_path);
+  const mbs::ModelLists lists = mbs::build_model_lists(model);
+  const std::string name = model.name;
+  MbsGeneration result;
+  result.scheme_assignments = lists.assignments_built;
+
+  EmitOptions emit;
+  emit.namespace_name = "dydp::generated";
+  emit.origin = model_path + (options.expand ? " (in extenso)" : " (recursive)");
+  const std::vector<ArrayId> all_seeded = mbs::tangent_arrays(lists);
+
+  auto plain = [&](const std::string& fn, const EquationList& list, bool expanded = false) {
+    emit.function_name = fn;
+    const EquationList written = expanded ? expand(list) : list;
+    result.functions.push_back({fn, lists.assignments_built, expanded ? written.outputs().size() : written.size(),
+                                count_ops(written)});
+    return emit_function(written, emit);
+  };
+  auto tangent = [&](const std::string& fn, const EquationList& list, std::vector<ArrayId> arrays) {
+    const Direction direction = seeded(list.context(), arrays);
+    EliminationStats stats;
+    const EquationList t = eliminate(differentiate(list, std::span<const Direction>(&direction, 1)), &stats);
+    emit.function_name = fn;
+    result.functions.push_back({fn, stats.before, t.size(), count_ops(t)});
+    return emit_tangent(t, arrays, emit);
+  };
+  auto seeded_fn = [&](const std::string& fn, const EquationList& list, std::vector<ArrayId> arrays) {
+    return tangent(fn, list, std::move(arrays));
+  };
+
+  std::filesystem::create_directories(options.out_dir);
+  if (options.expand) {
+    std::vector<EmittedFunction> fs;
+    for (const auto& j : lists.jacobians) fs.push_back(plain(j.name, *j.list, true));
+    const std::string header = name + "_expanded.hpp";
+    write_atomically(options.out_dir / header, emit_header_file(fs, emit));
+    write_atomically(options.out_dir / (name + "_expanded.cpp"), emit_source_file(fs, header, emit));
+    return result;
+  }
+
+  std::vector<EmittedFunction> dynamics, kinematics;
+  dynamics.push_back(seeded_fn(name + "_mass", *lists.inertial, {lists.qdd}));
+  dynamics.push_back(plain(name + "_residual", *lists.residual));
+  dynamics.push_back(tangent(name + "_residual_tangent", *lists.residual, all_seeded));
+  kinematics.push_back(plain(name + "_constraints", *lists.constraints));
+  kinematics.push_back(tangent(name + "_velocity_constraints_tangent", *lists.velocity_constraints, all_seeded));
+  kinematics.push_back(plain(name + "_sensors", *lists.sensors));
+  kinematics.push_back(tangent(name + "_sensors_tangent", *lists.sensors, all_seeded));
+  for (const auto& j : lists.jacobians) kinematics.push_back(plain(j.name, *j.list));
+
+  bool automatic = false;
+  const std::vector<int> independent = choose_independent(model, automatic);
+  result.independent_automatic = automatic;
+  for (int j : independent) result.independent.push_back(model.joints[j].name);
+
+  std::vector<EmittedFunction> all = dynamics;
+  all.insert(all.end(), kinematics.begin(), kinematics.end());
+  const std::string header = name + ".hpp";
+  std::string header_text = emit_header_file(all, emit);
+  header_text += "\n#include \"symbolic/mbs/generated_model.hpp\"\n\nnamespace dydp::generated {\nextern const dydp::mbs::GeneratedModel " +
+                 name + "_model;\n}  // namespace dydp::generated\n";
+  write_atomically(options.out_dir / header, header_text);
+  write_atomically(options.out_dir / (name + "_dynamics.cpp"), emit_source_file(dynamics, header, emit));
+  write_atomically(options.out_dir / (name + "_kinematics.cpp"), emit_source_file(kinematics, header, emit));
+
+  // The descriptor.
+  std::vector<std::string> coordinates, parameters;
+  std::vector<double> parameter_values, q0;
+  for (const auto& j : model.joints) {
+    coordinates.push_back(j.name);
+    q0.push_back(j.initial);
+  }
+  for (const auto& p : model.parameters)
+    if (p.symbolic) {
+      parameters.push_back(p.name);
+      parameter_values.push_back(p.value);
+    }
+  const std::vector<int> driven = model.driven_joints();
+  std::string d = "// Generated by dydp-gen; do not edit.\n// Source: " + emit.origin + "\n#include \"" + header +
+                  "\"\n\nnamespace dydp::generated {\nnamespace {\n";
+  d += string_array("coordinate_names", coordinates);
+  d += string_array("input_names", model.input_names());
+  d += string_array("parameter_names", parameters);
+  d += number_array("double", "parameter_values", parameter_values);
+  d += string_array("sensor_names", model.sensor_output_names());
+  d += number_array("double", "initial_q", q0);
+  d += number_array("int", "driven", driven);
+  d += number_array("int", "independent", independent);
+  d += "}  // namespace\n\n";
+  d += "// independent coordinates" + std::string(automatic ? " (automatic, pivoted QR of J at q0)" : "") + ":";
+  for (const auto& u : result.independent) d += " " + u;
+  d += "\nextern const dydp::mbs::GeneratedModel " + name + "_model = {\n";
+  d += "    \"" + name + "\", " + std::to_string(model.coordinates()) + ", " + std::to_string(model.constraint_count()) +
+       ", " + std::to_string(model.input_count()) + ", " + std::to_string(model.loads.size()) + ", " +
+       std::to_string(parameters.size()) + ", " + std::to_string(model.sensor_output_names().size()) + ",\n";
+  d += "    coordinate_names, input_names, parameter_names, parameter_values, sensor_names, initial_q,\n";
+  d += "    " + std::to_string(driven.size()) + ", driven, " + std::to_string(independent.size()) + ", independent,\n";
+  d += "    " + name + "_mass, " + name + "_residual, " + name + "_residual_tangent, " + name + "_constraints,\n";
+  d += "    " + name + "_velocity_constraints_tangent, " + name + "_sensors, " + name + "_sensors_tangent};\n\n";
+  d += "}  // namespace dydp::generated\n";
+  write_atomically(options.out_dir / (name + "_model.cpp"), d);
+  return result;
+}
+
+}  // namespace dydp::gen

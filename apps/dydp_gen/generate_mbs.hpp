@@ -1,0 +1,26 @@
+// The multibody front end of dydp-gen: a `*.mbs.yaml` model becomes its generated functions
+// (mass matrix columns, residual and tangent, constraints, sensors and tangent, point
+// Jacobians), split over translation units, and a GeneratedModel descriptor for the registry.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "generate.hpp"
+
+namespace dydp::gen {
+
+struct MbsGeneration {
+  std::vector<FunctionStats> functions;
+  std::size_t scheme_assignments = 0;  // the recursive scheme before elimination
+  std::vector<std::string> independent;  // names of the independent coordinates
+  bool independent_automatic = false;
+};
+
+// Writes NAME.hpp, NAME_dynamics.cpp, NAME_kinematics.cpp and NAME_model.cpp into out_dir.
+// With `expand`, writes only the point Jacobians in extenso (NAME_expanded.hpp/.cpp): the other
+// functions' in-extenso forms are far too large to write.
+MbsGeneration generate_mbs(const std::string& model_path, const GenerationOptions& options);
+
+}  // namespace dydp::gen

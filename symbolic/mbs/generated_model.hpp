@@ -1,0 +1,50 @@
+// What a generated multibody model exposes at run time: sizes, names, and pointers to its
+// generated functions. dydp-gen writes one constant of this type per model; generated_models/
+// collects them in a registry. Plain data: no dependency on the generator or the engine.
+#pragma once
+
+namespace dydp::mbs {
+
+// Every generated function reads the arrays q, qd, qdd (n), lam (m), inp (inputs), p (symbolic
+// parameters), in this order; arrays of size zero are passed as one unused element.
+using GeneratedFunction = void (*)(const double* q, const double* qd, const double* qdd, const double* lam,
+                                   const double* inp, const double* p, double* out);
+// Tangent seeded on q, qd, qdd, inp and p: seed (i, d) of array x (size s) at seed_x[d*s + i],
+// derivative (j, d) of output j (k outputs) at dout[d*k + j].
+using GeneratedTangent = void (*)(const double* q, const double* qd, const double* qdd, const double* lam,
+                                  const double* inp, const double* p, int nd, const double* seed_q,
+                                  const double* seed_qd, const double* seed_qdd, const double* seed_inp,
+                                  const double* seed_p, double* out, double* dout);
+// Tangent seeded on qdd only (the inertial pass: columns of M).
+using GeneratedMassTangent = void (*)(const double* q, const double* qd, const double* qdd, const double* lam,
+                                      const double* inp, const double* p, int nd, const double* seed_qdd,
+                                      double* out, double* dout);
+
+struct GeneratedModel {
+  const char* name;
+  int n;           // coordinates
+  int m;           // constraints
+  int inputs;      // 3 per load, then q, qd, qdd of each driven joint
+  int loads;       // number of loads (the first 3 * loads inputs)
+  int parameters;  // symbolic parameters
+  int sensor_outputs;
+  const char* const* coordinate_names;
+  const char* const* input_names;
+  const char* const* parameter_names;
+  const double* parameter_values;  // as written in the model
+  const char* const* sensor_names;
+  const double* initial_q;
+  int driven_count;
+  const int* driven;       // coordinates imposed by inputs
+  int independent_count;
+  const int* independent;  // coordinates u; the others (not driven) are dependent
+  GeneratedMassTangent mass;                       // seeded on qdd: columns of M
+  GeneratedFunction residual;                      // M qdd + c - J^T lam (n), J qdd + Jdot qd (m)
+  GeneratedTangent residual_tangent;
+  GeneratedFunction constraints;                   // h (m), J (m x n row-major), Jdot qd (m)
+  GeneratedTangent velocity_constraints_tangent;   // h (m), J qd (m)
+  GeneratedFunction sensors;
+  GeneratedTangent sensors_tangent;
+};
+
+}  // namespace dydp::mbs

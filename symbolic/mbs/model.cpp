@@ -1,0 +1,429 @@
+// Loader of `*.mbs.yaml` model descriptions. Every error names the file, the line and the field.
+#include "symbolic/mbs/model.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "symbolic/eqs_reader.hpp"  // ParseError
+
+namespace dydp::mbs {
+namespace {
+
+using symbolic::ParseError;
+
+class Loader {
+ public:
+  Loader(Model& model, std::string file) : m_(model), file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& field, const std::string& message) const {
+    const int line = node.IsDefined() ? node.Mark().line + 1 : 0;
+    throw ParseError(file_, line, field + ": " + message);
+  }
+
+  double number(const YAML::Node& node, const std::string& field) const {
+    if (!node.IsScalar()) fail(node, field, "expected a number");
+    try {
+      std::size_t used = 0;
+      const std::string s = node.Scalar();
+      const double v = std::stod(s, &used);
+      if (used != s.size()) throw std::invalid_argument(s);
+      return v;
+    } catch (const std::exception&) {
+      fail(node, field, "expected a number, got '" + node.Scalar() + "'");
+    }
+  }
+
+  std::string text(const YAML::Node& node, const std::string& field) const {
+    if (!node.IsScalar()) fail(node, field, "expected a name");
+    return node.Scalar();
+  }
+
+  // A number or `$parameter`.
+  Value value(const YAML::Node& node, const std::string& field) const {
+    const std::string s = node.IsScalar() ? node.Scalar() : std::string();
+    const bool negated = s.size() > 1 && s[0] == '-' && s[1] == '$';
+    if (!s.empty() && (s[0] == '$' || negated)) {
+      const std::string name = s.substr(negated ? 2 : 1);
+      for (std::size_t i = 0; i < m_.parameters.size(); ++i)
+        if (m_.parameters[i].name == name)
+          return Value{(negated ? -1.0 : 1.0) * m_.parameters[i].value, static_cast<int>(i), negated ? -1.0 : 1.0};
+      fail(node, field, "unknown parameter '" + name + "'");
+    }
+    return Value{number(node, field), -1};
+  }
+
+  Vec3Value vec3(const YAML::Node& node, const std::string& field) const {
+    if (!node.IsSequence() || node.size() != 3) fail(node, field, "expected a list of three values");
+    return {value(node[0], field), value(node[1], field), value(node[2], field)};
+  }
+
+  Value optional_value(const YAML::Node& parent, const char* key, const std::string& field, double fallback) const {
+    const YAML::Node n = parent[key];
+    return n ? value(n, field + "." + key) : Value{fallback, -1};
+  }
+
+  void check_keys(const YAML::Node& node, const std::string& field, std::initializer_list<const char*> keys) const {
+    if (!node.IsMap()) fail(node, field, "expected a mapping");
+    for (const auto& kv : node) {
+      const std::string k = kv.first.Scalar();
+      bool known = false;
+      for (const char* allowed : keys) known = known || k == allowed;
+      if (!known) fail(kv.first, field + "." + k, "unknown key");
+    }
+  }
+
+  int body_index(const YAML::Node& node, const std::string& name, const std::string& field) const {
+    for (std::size_t i = 0; i < m_.bodies.size(); ++i)
+      if (m_.bodies[i].name == name) return static_cast<int>(i);
+    fail(node, field, "unknown body '" + name + "'");
+  }
+
+  // `body.anchor`
+  PointRef point(const YAML::Node& node, const std::string& field) const {
+    const std::string s = text(node, field);
+    const auto dot = s.find('.');
+    if (dot == std::string::npos) fail(node, field, "expected BODY.ANCHOR, got '" + s + "'");
+    PointRef p;
+    p.body = body_index(node, s.substr(0, dot), field);
+    const std::string anchor = s.substr(dot + 1);
+    const auto& anchors = m_.bodies[p.body].anchors;
+    for (std::size_t i = 0; i < anchors.size(); ++i)
+      if (anchors[i].name == anchor) { p.anchor = static_cast<int>(i); return p; }
+    fail(node, field, "body '" + m_.bodies[p.body].name + "' has no anchor '" + anchor + "'");
+  }
+
+  int joint_index(const YAML::Node& node, const std::string& field) const {
+    const std::string s = text(node, field);
+    for (std::size_t i = 0; i < m_.joints.size(); ++i)
+      if (m_.joints[i].name == s) return static_cast<int>(i);
+    fail(node, field, "unknown joint '" + s + "'");
+  }
+
+  int frame(const YAML::Node& parent, const std::string& field) const {
+    const YAML::Node n = parent["frame"];
+    if (!n) return 0;
+    return body_index(n, text(n, field + ".frame"), field + ".frame");
+  }
+
+  void anchors(const YAML::Node& node, Body& body, const std::string& field) {
+    if (!node) return;
+    if (!node.IsMap()) fail(node, field, "expected a mapping NAME: [x, y, z]");
+    for (const auto& kv : node) {
+      const std::string name = kv.first.Scalar();
+      for (const Anchor& a : body.anchors)
+        if (a.name == name) fail(kv.first, field + "." + name, "duplicate anchor");
+      body.anchors.push_back({name, vec3(kv.second, field + "." + name)});
+    }
+  }
+
+  void load(const YAML::Node& root) {
+    check_keys(root, "model", {"model", "description", "gravity", "parameters", "ground", "bodies", "cuts",
+                               "forces", "loads", "sensors", "jacobians", "independent"});
+    if (root["model"]) m_.name = text(root["model"], "model");
+    if (const YAML::Node g = root["gravity"]) {
+      if (!g.IsSequence() || g.size() != 3) fail(g, "gravity", "expected [gx, gy, gz]");
+      for (int i = 0; i < 3; ++i) m_.gravity[i] = number(g[i], "gravity");
+    }
+    if (const YAML::Node ps = root["parameters"]) {
+      if (!ps.IsMap()) fail(ps, "parameters", "expected a mapping NAME: value");
+      for (const auto& kv : ps) {
+        Parameter p;
+        p.name = kv.first.Scalar();
+        const std::string field = "parameters." + p.name;
+        if (kv.second.IsMap()) {
+          check_keys(kv.second, field, {"value", "fold", "unit"});
+          if (!kv.second["value"]) fail(kv.second, field, "missing value");
+          p.value = number(kv.second["value"], field + ".value");
+          if (kv.second["fold"]) p.symbolic = !kv.second["fold"].as<bool>();
+        } else {
+          p.value = number(kv.second, field);
+        }
+        m_.parameters.push_back(p);
+      }
+    }
+    Body ground;
+    ground.name = "ground";
+    if (const YAML::Node g = root["ground"]) {
+      check_keys(g, "ground", {"anchors"});
+      anchors(g["anchors"], ground, "ground.anchors");
+    }
+    m_.bodies.push_back(ground);
+
+    const YAML::Node bodies = root["bodies"];
+    if (!bodies || !bodies.IsSequence() || bodies.size() == 0) fail(root, "bodies", "expected a non-empty list");
+    for (std::size_t bi = 0; bi < bodies.size(); ++bi) {
+      const YAML::Node b = bodies[bi];
+      std::string field = "bodies[" + std::to_string(bi) + "]";
+      check_keys(b, field, {"name", "parent", "offset", "joints", "mass", "com", "inertia", "anchors"});
+      Body body;
+      if (!b["name"]) fail(b, field, "missing name");
+      body.name = text(b["name"], field + ".name");
+      field = "bodies." + body.name;
+      for (const Body& other : m_.bodies)
+        if (other.name == body.name) fail(b["name"], field, "duplicate body name");
+      const int parent_body = b["parent"] ? body_index(b["parent"], text(b["parent"], field + ".parent"), field + ".parent") : 0;
+      Vec3Value offset{};
+      if (b["offset"]) offset = vec3(b["offset"], field + ".offset");
+      const YAML::Node js = b["joints"];
+      if (!js || !js.IsSequence() || js.size() == 0) fail(b, field + ".joints", "expected a non-empty list of joints");
+      int parent_joint = m_.bodies[parent_body].frame;
+      for (std::size_t k = 0; k < js.size(); ++k) {
+        const YAML::Node j = js[k];
+        const std::string jf = field + ".joints[" + std::to_string(k) + "]";
+        check_keys(j, jf, {"name", "type", "driven", "initial"});
+        Joint joint;
+        joint.name = j["name"] ? text(j["name"], jf + ".name") : body.name + "_" + std::to_string(k + 1);
+        for (const Joint& other : m_.joints)
+          if (other.name == joint.name) fail(j, jf + ".name", "duplicate joint name '" + joint.name + "'");
+        if (!j["type"]) fail(j, jf, "missing type (Rx Ry Rz Tx Ty Tz)");
+        static const std::map<std::string, JointType> types{{"Rx", JointType::Rx}, {"Ry", JointType::Ry},
+            {"Rz", JointType::Rz}, {"Tx", JointType::Tx}, {"Ty", JointType::Ty}, {"Tz", JointType::Tz}};
+        const auto t = types.find(text(j["type"], jf + ".type"));
+        if (t == types.end()) fail(j["type"], jf + ".type", "expected one of Rx Ry Rz Tx Ty Tz");
+        joint.type = t->second;
+        joint.parent = parent_joint;
+        if (k == 0) joint.offset = offset;
+        if (j["driven"]) joint.driven = j["driven"].as<bool>();
+        if (j["initial"]) joint.initial = number(j["initial"], jf + ".initial");
+        m_.joints.push_back(joint);
+        parent_joint = static_cast<int>(m_.joints.size()) - 1;
+      }
+      body.frame = parent_joint;
+      m_.joints[parent_joint].body = static_cast<int>(m_.bodies.size());
+      if (!b["mass"]) fail(b, field + ".mass", "missing");
+      body.mass = value(b["mass"], field + ".mass");
+      if (b["com"]) body.com = vec3(b["com"], field + ".com");
+      if (const YAML::Node in = b["inertia"]) {
+        if (!in.IsSequence() || (in.size() != 3 && in.size() != 6))
+          fail(in, field + ".inertia", "expected [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]");
+        for (std::size_t i = 0; i < in.size(); ++i) body.inertia[i] = value(in[i], field + ".inertia");
+      }
+      anchors(b["anchors"], body, field + ".anchors");
+      m_.bodies.push_back(body);
+    }
+
+    if (const YAML::Node cs = root["cuts"]) {
+      for (std::size_t i = 0; i < cs.size(); ++i) {
+        const YAML::Node c = cs[i];
+        std::string field = "cuts[" + std::to_string(i) + "]";
+        check_keys(c, field, {"name", "type", "a", "b", "components", "length"});
+        Cut cut;
+        cut.name = c["name"] ? text(c["name"], field + ".name") : "cut" + std::to_string(i + 1);
+        field = "cuts." + cut.name;
+        const std::string type = c["type"] ? text(c["type"], field + ".type") : "";
+        if (!c["a"] || !c["b"]) fail(c, field, "needs points a and b (BODY.ANCHOR)");
+        cut.a = point(c["a"], field + ".a");
+        cut.b = point(c["b"], field + ".b");
+        if (type == "ball") {
+          cut.type = Cut::Type::Ball;
+          if (const YAML::Node comp = c["components"]) {
+            for (std::size_t k = 0; k < comp.size(); ++k) {
+              const std::string s = text(comp[k], field + ".components");
+              if (s != "x" && s != "y" && s != "z") fail(comp[k], field + ".components", "expected x, y or z");
+              cut.components.push_back(s[0] - 'x');
+            }
+          } else {
+            cut.components = {0, 1, 2};
+          }
+        } else if (type == "distance") {
+          cut.type = Cut::Type::Distance;
+          if (!c["length"]) fail(c, field + ".length", "missing");
+          cut.length = value(c["length"], field + ".length");
+        } else {
+          fail(c["type"] ? c["type"] : c, field + ".type", "expected ball or distance");
+        }
+        m_.cuts.push_back(cut);
+      }
+    }
+
+    if (const YAML::Node fs = root["forces"]) {
+      for (std::size_t i = 0; i < fs.size(); ++i) {
+        const YAML::Node f = fs[i];
+        std::string field = "forces[" + std::to_string(i) + "]";
+        check_keys(f, field, {"name", "type", "a", "b", "stiffness", "rest_length", "damping", "joint", "value"});
+        ForceElement e;
+        e.name = f["name"] ? text(f["name"], field + ".name") : "force" + std::to_string(i + 1);
+        field = "forces." + e.name;
+        const std::string type = f["type"] ? text(f["type"], field + ".type") : "";
+        if (type == "spring") {
+          e.type = ForceElement::Type::Spring;
+          if (!f["a"] || !f["b"]) fail(f, field, "needs points a and b");
+          e.a = point(f["a"], field + ".a");
+          e.b = point(f["b"], field + ".b");
+          e.stiffness = optional_value(f, "stiffness", field, 0.0);
+          e.rest_length = optional_value(f, "rest_length", field, 0.0);
+          e.damping = optional_value(f, "damping", field, 0.0);
+        } else if (type == "joint_force") {
+          e.type = ForceElement::Type::JointForce;
+          if (!f["joint"] || !f["value"]) fail(f, field, "needs joint and value");
+          e.joint = joint_index(f["joint"], field + ".joint");
+          e.value = value(f["value"], field + ".value");
+        } else {
+          fail(f["type"] ? f["type"] : f, field + ".type", "expected spring or joint_force");
+        }
+        m_.forces.push_back(e);
+      }
+    }
+
+    if (const YAML::Node ls = root["loads"]) {
+      for (std::size_t i = 0; i < ls.size(); ++i) {
+        const YAML::Node l = ls[i];
+        std::string field = "loads[" + std::to_string(i) + "]";
+        check_keys(l, field, {"name", "type", "point", "body", "frame"});
+        Load load;
+        if (!l["name"]) fail(l, field, "missing name");
+        load.name = text(l["name"], field + ".name");
+        field = "loads." + load.name;
+        const std::string type = l["type"] ? text(l["type"], field + ".type") : "";
+        if (type == "force") {
+          load.type = Load::Type::Force;
+          if (!l["point"]) fail(l, field + ".point", "missing");
+          load.point = point(l["point"], field + ".point");
+        } else if (type == "torque") {
+          load.type = Load::Type::Torque;
+          if (!l["body"]) fail(l, field + ".body", "missing");
+          load.point.body = body_index(l["body"], text(l["body"], field + ".body"), field + ".body");
+        } else {
+          fail(l["type"] ? l["type"] : l, field + ".type", "expected force or torque");
+        }
+        load.frame = frame(l, field);
+        m_.loads.push_back(load);
+      }
+    }
+
+    if (const YAML::Node ss = root["sensors"]) {
+      for (std::size_t i = 0; i < ss.size(); ++i) {
+        const YAML::Node s = ss[i];
+        std::string field = "sensors[" + std::to_string(i) + "]";
+        check_keys(s, field, {"name", "type", "point", "a", "b", "frame", "joint"});
+        Sensor sensor;
+        if (!s["name"]) fail(s, field, "missing name");
+        sensor.name = text(s["name"], field + ".name");
+        field = "sensors." + sensor.name;
+        const std::string type = s["type"] ? text(s["type"], field + ".type") : "";
+        static const std::map<std::string, Sensor::Type> types{{"position", Sensor::Type::Position},
+            {"velocity", Sensor::Type::Velocity}, {"acceleration", Sensor::Type::Acceleration},
+            {"length", Sensor::Type::Length}, {"joint", Sensor::Type::Joint}};
+        const auto t = types.find(type);
+        if (t == types.end()) fail(s["type"] ? s["type"] : s, field + ".type",
+                                   "expected position, velocity, acceleration, length or joint");
+        sensor.type = t->second;
+        if (sensor.type == Sensor::Type::Length) {
+          if (!s["a"] || !s["b"]) fail(s, field, "needs points a and b");
+          sensor.a = point(s["a"], field + ".a");
+          sensor.b = point(s["b"], field + ".b");
+        } else if (sensor.type == Sensor::Type::Joint) {
+          if (!s["joint"]) fail(s, field + ".joint", "missing");
+          sensor.joint = joint_index(s["joint"], field + ".joint");
+        } else {
+          if (!s["point"]) fail(s, field + ".point", "missing");
+          sensor.a = point(s["point"], field + ".point");
+          sensor.frame = frame(s, field);
+        }
+        m_.sensors.push_back(sensor);
+      }
+    }
+
+    if (const YAML::Node js = root["jacobians"]) {
+      for (std::size_t i = 0; i < js.size(); ++i) {
+        const YAML::Node j = js[i];
+        const std::string field = "jacobians[" + std::to_string(i) + "]";
+        check_keys(j, field, {"name", "point"});
+        if (!j["name"] || !j["point"]) fail(j, field, "needs name and point");
+        m_.jacobians.push_back({text(j["name"], field + ".name"), point(j["point"], field + ".point")});
+      }
+    }
+
+    if (const YAML::Node ind = root["independent"]) {
+      if (!ind.IsSequence()) fail(ind, "independent", "expected a list of joint names");
+      for (std::size_t i = 0; i < ind.size(); ++i) {
+        const int k = joint_index(ind[i], "independent");
+        if (m_.joints[k].driven) fail(ind[i], "independent", "a driven joint cannot be independent");
+        m_.independent.push_back(k);
+      }
+    }
+  }
+
+ private:
+  Model& m_;
+  std::string file_;
+};
+
+}  // namespace
+
+int Model::constraint_count() const {
+  int m = 0;
+  for (const Cut& c : cuts) m += c.type == Cut::Type::Ball ? static_cast<int>(c.components.size()) : 1;
+  return m;
+}
+
+std::vector<int> Model::driven_joints() const {
+  std::vector<int> d;
+  for (std::size_t k = 0; k < joints.size(); ++k)
+    if (joints[k].driven) d.push_back(static_cast<int>(k));
+  return d;
+}
+
+int Model::input_count() const {
+  return 3 * static_cast<int>(loads.size()) + 3 * static_cast<int>(driven_joints().size());
+}
+
+std::vector<std::string> Model::input_names() const {
+  std::vector<std::string> names;
+  for (const Load& l : loads)
+    for (const char* c : {"x", "y", "z"}) names.push_back(l.name + "." + c);
+  for (int k : driven_joints())
+    for (const char* c : {"q", "qd", "qdd"}) names.push_back(joints[k].name + "." + c);
+  return names;
+}
+
+int Model::symbolic_parameter_count() const {
+  int n = 0;
+  for (const Parameter& p : parameters) n += p.symbolic;
+  return n;
+}
+
+std::vector<std::string> Model::sensor_output_names() const {
+  std::vector<std::string> names;
+  for (const Sensor& s : sensors) {
+    if (s.type == Sensor::Type::Length) {
+      names.push_back(s.name + ".length");
+      names.push_back(s.name + ".rate");
+    } else if (s.type == Sensor::Type::Joint) {
+      for (const char* c : {"q", "qd", "qdd"}) names.push_back(s.name + "." + c);
+    } else {
+      for (const char* c : {"x", "y", "z"}) names.push_back(s.name + "." + c);
+    }
+  }
+  return names;
+}
+
+Model parse_model(const std::string& text, const std::string& file) {
+  Model model;
+  model.file = file;
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw symbolic::ParseError(file, e.mark.line + 1, "yaml: " + e.msg);
+  }
+  Loader(model, file).load(root);
+  if (model.name.empty()) {
+    std::string stem = file.substr(file.find_last_of('/') + 1);
+    model.name = stem.substr(0, stem.find('.'));
+  }
+  return model;
+}
+
+Model load_model(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw symbolic::ParseError(path, 0, "file: cannot be read");
+  std::stringstream s;
+  s << in.rdbuf();
+  return parse_model(s.str(), path);
+}
+
+}  // namespace dydp::mbs

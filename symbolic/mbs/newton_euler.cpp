@@ -1,0 +1,477 @@
+// Symbolic recursive Newton-Euler. Kinematics forward from the ground, in the components of each
+// joint frame: omega_k = R_k^T omega_p + qd_k e (revolute), accelerations likewise with the
+// ground accelerating at -g so that gravity enters as an inertial force; then the wrenches
+// backward: f_k = m a_G - F_ext + sum R_c f_c, n_k = I omegadot + omega x I omega + c x m a_G -
+// N_ext + sum (R_c n_c + r_c x R_c f_c), joint force Q_k = e . n_k (revolute) or e . f_k.
+#include "symbolic/mbs/newton_euler.hpp"
+
+#include <array>
+
+#include "symbolic/differentiate.hpp"
+#include "symbolic/eliminate.hpp"
+
+namespace dydp::mbs {
+namespace {
+
+using symbolic::ArrayId;
+using symbolic::Context;
+using symbolic::Direction;
+using symbolic::EquationList;
+using symbolic::Expr;
+using symbolic::Output;
+using symbolic::SymbolKind;
+
+struct V3 {
+  std::array<Expr, 3> c;
+  Expr& operator[](int i) { return c[i]; }
+  Expr operator[](int i) const { return c[i]; }
+};
+V3 operator+(const V3& a, const V3& b) { return {{a[0] + b[0], a[1] + b[1], a[2] + b[2]}}; }
+V3 operator-(const V3& a, const V3& b) { return {{a[0] - b[0], a[1] - b[1], a[2] - b[2]}}; }
+V3 operator-(const V3& a) { return {{-a[0], -a[1], -a[2]}}; }
+V3 operator*(Expr s, const V3& a) { return {{s * a[0], s * a[1], s * a[2]}}; }
+Expr dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+V3 cross(const V3& a, const V3& b) {
+  return {{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}};
+}
+
+// A rotation matrix by its columns (ground components of the frame's unit vectors).
+struct Rot {
+  std::array<V3, 3> col;
+  V3 apply(const V3& v) const { return v[0] * col[0] + v[1] * col[1] + v[2] * col[2]; }
+  V3 apply_transpose(const V3& v) const { return {{dot(col[0], v), dot(col[1], v), dot(col[2], v)}}; }
+};
+
+EquationList with_outputs(const EquationList& source, std::vector<Output> outputs) {
+  EquationList list(source.context());
+  for (const auto& a : source.assignments()) list.append(a);
+  for (auto& o : outputs) list.add_output(std::move(o));
+  return list;
+}
+
+class Generator {
+ public:
+  Generator(const Model& model, ModelLists& out) : m_(model), out_(out) {
+    out_.context = std::make_unique<Context>();
+    Context& ctx = *out_.context;
+    ctx_ = &ctx;
+    const std::size_t n = model.coordinates();
+    std::vector<std::string> names;
+    for (const Joint& j : model.joints) names.push_back(j.name);
+    out_.q = ctx.add_array("q", n, SymbolKind::Input);
+    out_.qd = ctx.add_array("qd", n, SymbolKind::Input);
+    out_.qdd = ctx.add_array("qdd", n, SymbolKind::Input);
+    out_.lam = ctx.add_array("lam", std::max(1, model.constraint_count()), SymbolKind::Input);
+    out_.inp = ctx.add_array("inp", std::max(1, model.input_count()), SymbolKind::Input);
+    out_.p = ctx.add_array("p", std::max(1, model.symbolic_parameter_count()), SymbolKind::Parameter);
+    int k = 0;
+    for (const Parameter& par : model.parameters) param_index_.push_back(par.symbolic ? k++ : -1);
+    all_ = std::make_unique<EquationList>(ctx);
+  }
+
+  void run() {
+    positions();
+    velocities();
+    std::vector<Expr> qdd, zero(m_.coordinates(), ctx_->zero());
+    for (int j = 0; j < m_.coordinates(); ++j) qdd.push_back(ctx_->element(out_.qdd, j));
+
+    // The inertial pass: M qdd.
+    const std::vector<Expr> inertial = dynamics(qdd, /*full=*/false, "I");
+    // The full pass: M qdd + c - J^T lam.
+    const std::vector<Expr> residual = dynamics(qdd, /*full=*/true, "");
+    const std::vector<Expr> h = constraint_values();
+    const std::vector<Expr> sensors = sensor_values();
+    out_.assignments_built = all_->size();
+
+    const int n = m_.coordinates();
+    const int mc = m_.constraint_count();
+    auto outputs = [](const std::string& prefix, const std::vector<Expr>& values) {
+      std::vector<Output> o;
+      for (std::size_t i = 0; i < values.size(); ++i) o.push_back({prefix + "[" + std::to_string(i) + "]", values[i].id()});
+      return o;
+    };
+    out_.inertial = std::make_unique<EquationList>(symbolic::eliminate(with_outputs(*all_, outputs("Mqdd", inertial))));
+
+    // Constraint derivatives: along time with qdd (accelerations), along time with qdd = 0
+    // (Jdot qd), along every q (J).
+    const EquationList h_list = symbolic::eliminate(with_outputs(*all_, outputs("h", h)));
+    Direction time_full{"t", "t", {}}, time_velocity{"v", "v", {}};
+    std::vector<Direction> along_q;
+    for (int j = 0; j < n; ++j) {
+      const Expr qj = ctx_->element(out_.q, j), qdj = ctx_->element(out_.qd, j);
+      time_full.seeds.push_back({qj.id(), qdj.id()});
+      time_full.seeds.push_back({qdj.id(), ctx_->element(out_.qdd, j).id()});
+      time_velocity.seeds.push_back({qj.id(), qdj.id()});
+      along_q.push_back(symbolic::along(qj));
+    }
+    const EquationList h_dot = symbolic::differentiate(h_list, std::span(&time_velocity, 1));
+    const EquationList h_ddot = symbolic::differentiate(symbolic::differentiate(h_list, std::span(&time_full, 1)),
+                                                        std::span(&time_full, 1));
+    const EquationList h_bias = symbolic::differentiate(h_dot, std::span(&time_velocity, 1));
+    const EquationList h_jac = symbolic::differentiate(h_list, along_q);
+
+    // residual: r then J qdd + Jdot qd (the last m outputs of the twice differentiated list)
+    {
+      std::vector<Output> o = outputs("r", residual);
+      for (int i = 0; i < mc; ++i) o.push_back({"a[" + std::to_string(i) + "]", h_ddot.outputs()[3 * mc + i].value});
+      out_.residual = merged(outputs("r", residual), {&h_list, &h_ddot}, std::move(o));
+    }
+    {
+      std::vector<Output> o = outputs("h", h);
+      for (int i = 0; i < mc; ++i)
+        for (int j = 0; j < n; ++j)
+          o.push_back({"J[" + std::to_string(i) + "," + std::to_string(j) + "]", h_jac.outputs()[mc + j * mc + i].value});
+      for (int i = 0; i < mc; ++i) o.push_back({"Jdqd[" + std::to_string(i) + "]", h_bias.outputs()[3 * mc + i].value});
+      out_.constraints = merged({}, {&h_list, &h_jac, &h_dot, &h_bias}, std::move(o));
+    }
+    {
+      std::vector<Output> o = outputs("h", h);
+      for (int i = 0; i < mc; ++i) o.push_back({"hdot[" + std::to_string(i) + "]", h_dot.outputs()[mc + i].value});
+      out_.velocity_constraints = merged({}, {&h_list, &h_dot}, std::move(o));
+    }
+    out_.sensors = std::make_unique<EquationList>(symbolic::eliminate(with_outputs(*all_, outputs("s", sensors))));
+
+    for (const JacobianRequest& request : m_.jacobians) {
+      const V3 x = point_position(request.point);
+      std::vector<Expr> xs{x[0], x[1], x[2]};
+      const EquationList x_list = symbolic::eliminate(with_outputs(*all_, outputs("x", xs)));
+      const EquationList dx = symbolic::differentiate(x_list, along_q);
+      std::vector<Output> o;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < n; ++j)
+          o.push_back({"J[" + std::to_string(i) + "," + std::to_string(j) + "]", dx.outputs()[3 + 3 * j + i].value});
+      EquationList list(*ctx_);
+      for (const auto& a : dx.assignments()) list.append(a);
+      for (auto& output : o) list.add_output(std::move(output));
+      out_.jacobians.push_back({request.name, std::make_unique<EquationList>(symbolic::eliminate(list))});
+    }
+  }
+
+ private:
+  // One list from the recursive scheme (the part `base_outputs` and every list's primal part
+  // need) followed by the derivative assignments of the differentiated lists, eliminated.
+  // Each differentiated list's primal part is an elimination of the scheme, so its
+  // assignments are either in the scheme or derivative assignments.
+  std::unique_ptr<EquationList> merged(std::vector<Output> base_outputs, std::vector<const EquationList*> lists,
+                                       std::vector<Output> outputs) {
+    const std::size_t primal = lists.front()->size();
+    for (const auto& o : lists.front()->outputs()) base_outputs.push_back(o);
+    const EquationList base = symbolic::eliminate(with_outputs(*all_, std::move(base_outputs)));
+    EquationList list(*ctx_);
+    for (const auto& a : base.assignments()) list.append(a);
+    std::vector<bool> seen(ctx_->size(), false);
+    for (const auto& a : base.assignments()) seen[a.target] = true;
+    for (const EquationList* l : lists) {
+      for (std::size_t i = primal; i < l->size(); ++i) {
+        const auto& a = l->assignments()[i];
+        if (a.target < seen.size() && seen[a.target]) continue;
+        if (a.target >= seen.size()) seen.resize(ctx_->size(), false);
+        seen[a.target] = true;
+        list.append(a);
+      }
+    }
+    for (auto& o : outputs) list.add_output(std::move(o));
+    return std::make_unique<EquationList>(symbolic::eliminate(list));
+  }
+
+  Expr val(const Value& v) {
+    if (v.param >= 0 && param_index_[v.param] >= 0) return v.scale * ctx_->element(out_.p, param_index_[v.param]);
+    return ctx_->constant(m_.value(v));
+  }
+  V3 vec(const Vec3Value& v) { return {{val(v[0]), val(v[1]), val(v[2])}}; }
+  V3 zero3() { return {{ctx_->zero(), ctx_->zero(), ctx_->zero()}}; }
+  V3 unit(int axis) {
+    V3 e = zero3();
+    e[axis] = ctx_->one();
+    return e;
+  }
+  V3 assign(const std::string& name, int k, const V3& v) {
+    V3 r;
+    for (int i = 0; i < 3; ++i) r[i] = all_->assign(name + std::to_string(i + 1) + "_" + std::to_string(k + 1), v[i]);
+    return r;
+  }
+
+  // Relative rotation of joint k (its frame to its parent's): v_parent = R v_k.
+  V3 rotate(int k, const V3& v) {
+    const Joint& j = m_.joints[k];
+    if (!is_revolute(j.type)) return v;
+    const int a = axis_of(j.type), i = (a + 1) % 3, l = (a + 2) % 3;
+    const Expr c = cos_[k], s = sin_[k];
+    V3 r = v;
+    r[i] = c * v[i] - s * v[l];
+    r[l] = s * v[i] + c * v[l];
+    return r;
+  }
+  V3 rotate_back(int k, const V3& v) {
+    const Joint& j = m_.joints[k];
+    if (!is_revolute(j.type)) return v;
+    const int a = axis_of(j.type), i = (a + 1) % 3, l = (a + 2) % 3;
+    const Expr c = cos_[k], s = sin_[k];
+    V3 r = v;
+    r[i] = c * v[i] + s * v[l];
+    r[l] = -s * v[i] + c * v[l];
+    return r;
+  }
+  // Origin of joint k relative to its parent's origin, parent components.
+  V3 joint_offset(int k) {
+    const Joint& j = m_.joints[k];
+    V3 r = vec(j.offset);
+    if (!is_revolute(j.type)) r[axis_of(j.type)] = r[axis_of(j.type)] + ctx_->element(out_.q, k);
+    return r;
+  }
+
+  // Absolute rotations and origins.
+  void positions() {
+    const int n = m_.coordinates();
+    rot_.resize(n);
+    origin_.resize(n);
+    offset_.resize(n);
+    for (int k = 0; k < n; ++k) {
+      cos_.push_back(symbolic::cos(ctx_->element(out_.q, k)));
+      sin_.push_back(symbolic::sin(ctx_->element(out_.q, k)));
+    }
+    for (int k = 0; k < n; ++k) {
+      const Joint& j = m_.joints[k];
+      const Rot parent = j.parent >= 0 ? rot_[j.parent] : Rot{{unit(0), unit(1), unit(2)}};
+      const V3 parent_origin = j.parent >= 0 ? origin_[j.parent] : zero3();
+      offset_[k] = joint_offset(k);
+      Rot r = parent;
+      if (is_revolute(j.type)) {
+        const int a = axis_of(j.type), i = (a + 1) % 3, l = (a + 2) % 3;
+        r.col[i] = cos_[k] * parent.col[i] + sin_[k] * parent.col[l];
+        r.col[l] = -sin_[k] * parent.col[i] + cos_[k] * parent.col[l];
+      }
+      for (int c = 0; c < 3; ++c) r.col[c] = assign("R" + std::to_string(c + 1), k, r.col[c]);
+      rot_[k] = r;
+      origin_[k] = assign("X", k, parent_origin + parent.apply(offset_[k]));
+    }
+  }
+
+  // Angular velocity and origin velocity of every joint frame, own components.
+  void velocities() {
+    const int n = m_.coordinates();
+    omega_.resize(n);
+    velocity_.resize(n);
+    for (int k = 0; k < n; ++k) {
+      const Joint& j = m_.joints[k];
+      const V3 wp = j.parent >= 0 ? omega_[j.parent] : zero3();
+      const V3 vp = j.parent >= 0 ? velocity_[j.parent] : zero3();
+      const Expr qd = ctx_->element(out_.qd, k);
+      const V3 e = unit(axis_of(j.type));
+      V3 w = rotate_back(k, wp), v = rotate_back(k, vp + cross(wp, offset_[k]));
+      if (is_revolute(j.type)) w = w + qd * e;
+      else v = v + qd * e;
+      omega_[k] = assign("OM", k, w);
+      velocity_[k] = assign("V", k, v);
+    }
+  }
+
+  Rot body_rotation(int body) {
+    const int f = m_.bodies[body].frame;
+    return f < 0 ? Rot{{unit(0), unit(1), unit(2)}} : rot_[f];
+  }
+  V3 body_origin(int body) {
+    const int f = m_.bodies[body].frame;
+    return f < 0 ? zero3() : origin_[f];
+  }
+  V3 anchor(PointRef p) { return vec(m_.bodies[p.body].anchors[p.anchor].position); }
+  V3 point_position(PointRef p) { return body_origin(p.body) + body_rotation(p.body).apply(anchor(p)); }
+  V3 point_velocity(PointRef p) {
+    const int f = m_.bodies[p.body].frame;
+    if (f < 0) return zero3();
+    return rot_[f].apply(velocity_[f] + cross(omega_[f], anchor(p)));
+  }
+
+  // The Newton-Euler passes. `full`: gravity, velocities, loads, force elements and cut forces;
+  // otherwise the inertial pass (M qdd). Returns the joint forces.
+  std::vector<Expr> dynamics(const std::vector<Expr>& qdd, bool full, const std::string& tag) {
+    const int n = m_.coordinates();
+    std::vector<V3> omega(n), alpha(n), acc(n);
+    for (int k = 0; k < n; ++k) {
+      const Joint& j = m_.joints[k];
+      const V3 wp = j.parent >= 0 ? omega[j.parent] : zero3();
+      const V3 ap = j.parent >= 0 ? alpha[j.parent] : zero3();
+      V3 accp = zero3();
+      if (j.parent >= 0) accp = acc[j.parent];
+      else if (full) accp = -V3{{ctx_->constant(m_.gravity[0]), ctx_->constant(m_.gravity[1]), ctx_->constant(m_.gravity[2])}};
+      const V3 e = unit(axis_of(j.type));
+      const Expr qd = full ? ctx_->element(out_.qd, k) : ctx_->zero();
+      const V3 r = offset_[k];
+      V3 a = rotate_back(k, accp + cross(ap, r) + cross(wp, cross(wp, r)));
+      V3 al = rotate_back(k, ap);
+      if (is_revolute(j.type)) {
+        al = al + qdd[k] * e + cross(rotate_back(k, wp), qd * e);
+      } else {
+        a = a + qdd[k] * e + 2.0 * qd * cross(rotate_back(k, wp), e);
+      }
+      omega[k] = full ? omega_[k] : zero3();
+      alpha[k] = assign("OMP" + tag, k, al);
+      acc[k] = assign("A" + tag, k, a);
+    }
+    if (full) {
+      full_alpha_ = alpha;
+      full_acc_ = acc;
+    }
+
+    // External wrenches on each body about its frame origin, body components.
+    std::vector<V3> ext_f(m_.bodies.size(), zero3()), ext_n(m_.bodies.size(), zero3());
+    auto apply = [&](PointRef p, const V3& ground_force) {
+      if (p.body == 0) return;
+      const V3 f = body_rotation(p.body).apply_transpose(ground_force);
+      ext_f[p.body] = ext_f[p.body] + f;
+      ext_n[p.body] = ext_n[p.body] + cross(anchor(p), f);
+    };
+    std::vector<Expr> joint_force(n, ctx_->zero());
+    if (full) {
+      for (std::size_t i = 0; i < m_.loads.size(); ++i) {
+        const Load& l = m_.loads[i];
+        const V3 given{{ctx_->element(out_.inp, 3 * i), ctx_->element(out_.inp, 3 * i + 1), ctx_->element(out_.inp, 3 * i + 2)}};
+        const V3 ground = body_rotation(l.frame).apply(given);
+        if (l.type == Load::Type::Force) {
+          apply(l.point, ground);
+        } else if (l.point.body != 0) {
+          ext_n[l.point.body] = ext_n[l.point.body] + body_rotation(l.point.body).apply_transpose(ground);
+        }
+      }
+      int row = 0;
+      for (const Cut& c : m_.cuts) {
+        V3 f = zero3();
+        if (c.type == Cut::Type::Ball) {
+          for (int comp : c.components) f[comp] = ctx_->element(out_.lam, row++);
+        } else {
+          const V3 d = point_position(c.b) - point_position(c.a);
+          const Expr length = all_->assign("LC" + std::to_string(row + 1), symbolic::sqrt(dot(d, d)));
+          f = (ctx_->element(out_.lam, row++) / length) * d;
+        }
+        apply(c.b, f);
+        apply(c.a, -f);
+      }
+      int spring = 0;
+      for (const ForceElement& e : m_.forces) {
+        if (e.type == ForceElement::Type::JointForce) {
+          joint_force[e.joint] = joint_force[e.joint] + val(e.value);
+          continue;
+        }
+        ++spring;
+        const V3 d = assign("DS", spring - 1, point_position(e.b) - point_position(e.a));
+        const Expr length = all_->assign("LS" + std::to_string(spring), symbolic::sqrt(dot(d, d)));
+        const V3 dv = point_velocity(e.b) - point_velocity(e.a);
+        const Expr rate = all_->assign("LSD" + std::to_string(spring), dot(d, dv) / length);
+        const Expr tension = all_->assign("FS" + std::to_string(spring),
+            val(e.stiffness) * (length - val(e.rest_length)) + val(e.damping) * rate);
+        const V3 f = (tension / length) * d;
+        apply(e.a, f);
+        apply(e.b, -f);
+      }
+    }
+
+    std::vector<V3> child_f(n, zero3()), child_n(n, zero3());
+    std::vector<Expr> q_force(n);
+    for (int k = n - 1; k >= 0; --k) {
+      const Joint& j = m_.joints[k];
+      V3 f = child_f[k], t = child_n[k];
+      if (j.body >= 0) {
+        const Body& b = m_.bodies[j.body];
+        const Expr mass = val(b.mass);
+        const V3 com = vec(b.com);
+        const V3 w = omega[k], al = alpha[k];
+        const V3 acc_g = acc[k] + cross(al, com) + cross(w, cross(w, com));
+        const V3 inertial = mass * acc_g;
+        const Expr ixx = val(b.inertia[0]), iyy = val(b.inertia[1]), izz = val(b.inertia[2]);
+        const Expr ixy = val(b.inertia[3]), ixz = val(b.inertia[4]), iyz = val(b.inertia[5]);
+        auto I = [&](const V3& v) {
+          return V3{{ixx * v[0] + ixy * v[1] + ixz * v[2], ixy * v[0] + iyy * v[1] + iyz * v[2],
+                     ixz * v[0] + iyz * v[1] + izz * v[2]}};
+        };
+        f = f + inertial - ext_f[j.body];
+        t = t + I(al) + cross(w, I(w)) + cross(com, inertial) - ext_n[j.body];
+      }
+      f = assign("F" + tag, k, f);
+      t = assign("N" + tag, k, t);
+      const V3 e = unit(axis_of(j.type));
+      q_force[k] = all_->assign("Q" + tag + std::to_string(k + 1), (is_revolute(j.type) ? dot(e, t) : dot(e, f)) - joint_force[k]);
+      if (j.parent >= 0) {
+        const V3 fp = rotate(k, f);
+        child_f[j.parent] = child_f[j.parent] + fp;
+        child_n[j.parent] = child_n[j.parent] + rotate(k, t) + cross(offset_[k], fp);
+      }
+    }
+    return q_force;
+  }
+
+  std::vector<Expr> constraint_values() {
+    std::vector<Expr> h;
+    int row = 0;
+    for (const Cut& c : m_.cuts) {
+      const V3 d = point_position(c.b) - point_position(c.a);
+      if (c.type == Cut::Type::Ball) {
+        for (int comp : c.components) h.push_back(all_->assign("H" + std::to_string(++row), d[comp]));
+      } else {
+        h.push_back(all_->assign("H" + std::to_string(++row), symbolic::sqrt(dot(d, d)) - val(c.length)));
+      }
+    }
+    return h;
+  }
+
+  V3 point_acceleration(PointRef p) {
+    // ground components; the scheme's accelerations are relative to a ground accelerating at -g
+    const int f = m_.bodies[p.body].frame;
+    if (f < 0) return zero3();
+    const V3 r = anchor(p);
+    const V3 g{{ctx_->constant(m_.gravity[0]), ctx_->constant(m_.gravity[1]), ctx_->constant(m_.gravity[2])}};
+    return rot_[f].apply(full_acc_[f] + cross(full_alpha_[f], r) + cross(omega_[f], cross(omega_[f], r))) + g;
+  }
+
+  std::vector<Expr> sensor_values() {
+    std::vector<Expr> values;
+    int index = 0;
+    for (const Sensor& s : m_.sensors) {
+      ++index;
+      const std::string name = "SENS" + std::to_string(index) + "_";
+      V3 v;
+      switch (s.type) {
+        case Sensor::Type::Position:
+          v = body_rotation(s.frame).apply_transpose(point_position(s.a) - body_origin(s.frame));
+          break;
+        case Sensor::Type::Velocity: v = body_rotation(s.frame).apply_transpose(point_velocity(s.a)); break;
+        case Sensor::Type::Acceleration: v = body_rotation(s.frame).apply_transpose(point_acceleration(s.a)); break;
+        case Sensor::Type::Joint:
+          v = V3{{ctx_->element(out_.q, s.joint), ctx_->element(out_.qd, s.joint), ctx_->element(out_.qdd, s.joint)}};
+          break;
+        case Sensor::Type::Length: {
+          const V3 d = assign(name + "D", 0, point_position(s.b) - point_position(s.a));
+          const Expr length = all_->assign(name + "L", symbolic::sqrt(dot(d, d)));
+          values.push_back(length);
+          values.push_back(all_->assign(name + "LD", dot(d, point_velocity(s.b) - point_velocity(s.a)) / length));
+          continue;
+        }
+      }
+      v = assign(name, 0, v);
+      values.insert(values.end(), v.c.begin(), v.c.end());
+    }
+    return values;
+  }
+
+  const Model& m_;
+  ModelLists& out_;
+  Context* ctx_ = nullptr;
+  std::unique_ptr<EquationList> all_;
+  std::vector<int> param_index_;
+  std::vector<Expr> cos_, sin_;
+  std::vector<Rot> rot_;
+  std::vector<V3> origin_, offset_, omega_, velocity_, full_alpha_, full_acc_;
+};
+
+}  // namespace
+
+ModelLists build_model_lists(const Model& model) {
+  ModelLists lists;
+  Generator(model, lists).run();
+  return lists;
+}
+
+std::vector<symbolic::ArrayId> tangent_arrays(const ModelLists& lists) {
+  return {lists.q, lists.qd, lists.qdd, lists.inp, lists.p};
+}
+
+}  // namespace dydp::mbs

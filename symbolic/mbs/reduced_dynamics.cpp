@@ -1,0 +1,194 @@
+// Coordinate partitioning over the generated functions (see reduced_dynamics.hpp).
+#include "symbolic/mbs/reduced_dynamics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace dydp::mbs {
+
+ReducedDynamics::ReducedDynamics(const GeneratedModel& model) : model_(model), pad_(64, 0.0) {
+  std::vector<int> kind(model.n, 1);  // 0 independent, 1 dependent, 2 driven
+  for (int i = 0; i < model.independent_count; ++i) kind[model.independent[i]] = 0;
+  for (int i = 0; i < model.driven_count; ++i) kind[model.driven[i]] = 2;
+  for (int j = 0; j < model.n; ++j) {
+    if (kind[j] == 0) u_.push_back(j);
+    if (kind[j] == 1) v_.push_back(j);
+    if (kind[j] == 2) d_.push_back(j);
+    else f_.push_back(j);
+  }
+  if (static_cast<int>(v_.size()) != model.m)
+    throw std::runtime_error(std::string(model.name) + ": dependent coordinates do not match the constraints");
+  u_.assign(model.independent, model.independent + model.independent_count);
+}
+
+void ReducedDynamics::solve(const double* u, const double* ud, const double* inputs, const double* p_in,
+                            const Vector& guess, Result& r) const {
+  const int n = model_.n, m = model_.m, nu = this->nu();
+  const double* p = params(p_in);
+  const double* lam0 = pad_.data();
+  std::vector<double> lam_zero(std::max(1, m), 0.0);
+  r.q = guess;
+  r.qd = Vector::Zero(n);
+  r.qdd = Vector::Zero(n);
+  for (int i = 0; i < nu; ++i) {
+    r.q[u_[i]] = u[i];
+    r.qd[u_[i]] = ud[i];
+  }
+  const int driven_at = 3 * model_.loads;
+  for (std::size_t i = 0; i < d_.size(); ++i) {
+    r.q[d_[i]] = inputs[driven_at + 3 * i];
+    r.qd[d_[i]] = inputs[driven_at + 3 * i + 1];
+    r.qdd[d_[i]] = inputs[driven_at + 3 * i + 2];
+  }
+  const double* in = model_.inputs ? inputs : pad_.data();
+
+  // Constraints: h, J, Jdot qd.
+  std::vector<double> hj(m + m * n + m + 1);
+  r.J.resize(m, n);
+  auto evaluate_constraints = [&] {
+    model_.constraints(r.q.data(), r.qd.data(), r.qdd.data(), lam_zero.data(), in, p, hj.data());
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; j < n; ++j) r.J(i, j) = hj[m + i * n + j];
+  };
+  auto columns = [&](const Matrix& A, const std::vector<int>& cols) {
+    Matrix C(A.rows(), static_cast<Eigen::Index>(cols.size()));
+    for (std::size_t i = 0; i < cols.size(); ++i) C.col(i) = A.col(cols[i]);
+    return C;
+  };
+  r.newton_iterations = 0;
+  if (m > 0) {
+    for (;;) {
+      evaluate_constraints();
+      double norm = 0.0;
+      for (int i = 0; i < m; ++i) norm = std::max(norm, std::abs(hj[i]));
+      r.Jv.compute(columns(r.J, v_));
+      if (norm < 1e-13) break;
+      if (++r.newton_iterations > 30 || !std::isfinite(norm))
+        throw std::runtime_error(std::string(model_.name) + ": Newton-Raphson on the constraints did not converge");
+      const Vector dv = r.Jv.solve(Eigen::Map<const Vector>(hj.data(), m));
+      for (int i = 0; i < m; ++i) r.q[v_[i]] -= dv[i];
+    }
+    const Vector vd = r.Jv.solve(-(r.J * r.qd));
+    for (int i = 0; i < m; ++i) r.qd[v_[i]] = vd[i];
+    evaluate_constraints();  // Jdot qd with the completed velocities
+  }
+
+  // M from the inertial pass seeded on unit accelerations.
+  std::vector<double> out(n), dout(static_cast<std::size_t>(n) * n);
+  const Matrix eye = Matrix::Identity(n, n);
+  model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, n, eye.data(), out.data(), dout.data());
+  r.M = Eigen::Map<const Matrix>(dout.data(), n, n);
+
+  // c (with the driven accelerations) and the constraint bias.
+  std::vector<double> res(n + m);
+  model_.residual(r.q.data(), r.qd.data(), r.qdd.data(), lam_zero.data(), in, p, res.data());
+  const Vector c = Eigen::Map<const Vector>(res.data(), n);
+  const Vector a0 = Eigen::Map<const Vector>(res.data() + n, m);
+
+  const int nf = static_cast<int>(f_.size());
+  Matrix Mff(nf, nf);
+  for (int a = 0; a < nf; ++a)
+    for (int b = 0; b < nf; ++b) Mff(a, b) = r.M(f_[a], f_[b]);
+  // B over the free coordinates: rows u (identity) and v (-Jv^-1 Ju).
+  r.B = Matrix::Zero(nf, nu);
+  Vector beta = Vector::Zero(nf);
+  Matrix Bv, beta_v;
+  if (m > 0) {
+    Bv = -r.Jv.solve(columns(r.J, u_));
+    beta_v = -r.Jv.solve(a0);
+  }
+  for (int a = 0; a < nf; ++a) {
+    const int j = f_[a];
+    const auto iu = std::find(u_.begin(), u_.end(), j);
+    if (iu != u_.end()) {
+      r.B(a, iu - u_.begin()) = 1.0;
+    } else {
+      const int iv = static_cast<int>(std::find(v_.begin(), v_.end(), j) - v_.begin());
+      r.B.row(a) = Bv.row(iv);
+      beta[a] = beta_v(iv, 0);
+    }
+  }
+  Vector cf(nf);
+  for (int a = 0; a < nf; ++a) cf[a] = c[f_[a]];
+  r.reduced.compute(r.B.transpose() * Mff * r.B);
+  if (r.reduced.info() != Eigen::Success)
+    throw std::runtime_error(std::string(model_.name) + ": reduced mass matrix is not positive definite");
+  r.udd = r.reduced.solve(-(r.B.transpose() * (cf + Mff * beta)));
+  const Vector qddf = r.B * r.udd + beta;
+  for (int a = 0; a < nf; ++a) r.qdd[f_[a]] = qddf[a];
+
+  // Multipliers: J^T lam = M qdd + c on the dependent rows.
+  r.lam = Vector::Zero(m);
+  if (m > 0) {
+    Vector full = c;
+    for (int a = 0; a < nf; ++a) full += r.M.col(f_[a]) * qddf[a];
+    Vector fv(m);
+    for (int i = 0; i < m; ++i) fv[i] = full[v_[i]];
+    r.lam = r.Jv.transpose().solve(fv);
+  }
+}
+
+void ReducedDynamics::tangent(const Result& r, const double* inputs, const double* p_in, int nd, const double* du,
+                              const double* dud, const double* dinputs, const double* dp_in, Matrix& dq, Matrix& dqd,
+                              Matrix& dqdd) const {
+  const int n = model_.n, m = model_.m, nu = this->nu();
+  const int ni = std::max(1, model_.inputs), np = std::max(1, model_.parameters);
+  const double* p = params(p_in);
+  const double* in = model_.inputs ? inputs : pad_.data();
+  dq = Matrix::Zero(n, nd);
+  dqd = Matrix::Zero(n, nd);
+  dqdd = Matrix::Zero(n, nd);
+  Matrix dinp = Matrix::Zero(ni, nd), dp = Matrix::Zero(np, nd);
+  if (dinputs && model_.inputs) dinp = Eigen::Map<const Matrix>(dinputs, model_.inputs, nd);
+  if (dp_in && model_.parameters) dp = Eigen::Map<const Matrix>(dp_in, model_.parameters, nd);
+  const int driven_at = 3 * model_.loads;
+  for (int d = 0; d < nd; ++d) {
+    for (int i = 0; i < nu; ++i) {
+      dq(u_[i], d) = du ? du[d * nu + i] : 0.0;
+      dqd(u_[i], d) = dud ? dud[d * nu + i] : 0.0;
+    }
+    for (std::size_t i = 0; i < d_.size(); ++i) {
+      dq(d_[i], d) = dinp(driven_at + 3 * i, d);
+      dqd(d_[i], d) = dinp(driven_at + 3 * i + 1, d);
+      dqdd(d_[i], d) = dinp(driven_at + 3 * i + 2, d);
+    }
+  }
+  const Vector lam = m ? r.lam : Vector::Zero(1);
+  if (m > 0) {
+    // dh = Ju du + Jv dv + h_p dp = 0, then d(J qd) = 0 likewise for dv_dot.
+    std::vector<double> out(2 * m);
+    Matrix dout(2 * m, nd);
+    model_.velocity_constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), in, p, nd, dq.data(),
+                                        dqd.data(), dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
+    const Matrix dv = -r.Jv.solve(Matrix(dout.topRows(m)));
+    for (int i = 0; i < m; ++i) dq.row(v_[i]) = dv.row(i);
+    model_.velocity_constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), in, p, nd, dq.data(),
+                                        dqd.data(), dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
+    const Matrix dvd = -r.Jv.solve(Matrix(dout.bottomRows(m)));
+    for (int i = 0; i < m; ++i) dqd.row(v_[i]) = dvd.row(i);
+  }
+  // dr = dM qdd + dc - dJ^T lam (qdd, lam frozen; driven dqdd seeded), da = dJ qdd + d(Jdot qd).
+  std::vector<double> out(n + m);
+  Matrix dout(n + m, nd);
+  model_.residual_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), in, p, nd, dq.data(), dqd.data(),
+                          dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
+  const int nf = static_cast<int>(f_.size());
+  Matrix dbeta = Matrix::Zero(nf, nd), drf(nf, nd), Mff(nf, nf);
+  if (m > 0) {
+    const Matrix dbeta_v = -r.Jv.solve(Matrix(dout.bottomRows(m)));
+    for (int a = 0; a < nf; ++a) {
+      const auto iv = std::find(v_.begin(), v_.end(), f_[a]);
+      if (iv != v_.end()) dbeta.row(a) = dbeta_v.row(iv - v_.begin());
+    }
+  }
+  for (int a = 0; a < nf; ++a) {
+    drf.row(a) = dout.row(f_[a]);
+    for (int b = 0; b < nf; ++b) Mff(a, b) = r.M(f_[a], f_[b]);
+  }
+  const Matrix dudd = r.reduced.solve(-(r.B.transpose() * (drf + Mff * dbeta)));
+  const Matrix dqddf = r.B * dudd + dbeta;
+  for (int a = 0; a < nf; ++a) dqdd.row(f_[a]) = dqddf.row(a);
+}
+
+}  // namespace dydp::mbs

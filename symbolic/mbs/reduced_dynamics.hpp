@@ -1,0 +1,59 @@
+// The explicit direct dynamics of a generated model by coordinate partitioning:
+// u independent, v dependent, d driven. Newton-Raphson on h(u, v) = 0 for v, v_dot = -Jv^-1 Ju u_dot,
+// qdd = B udd + beta with B = [I; -Jv^-1 Ju], the reduced system B^T M B udd = -B^T (c + M beta)
+// solved by Cholesky, and the multipliers from the v rows. Its tangent reuses the factors:
+// dv = -Jv^-1 (Ju du + dh/dp dp), and the same Cholesky factor for dudd.
+#pragma once
+
+#include <Eigen/Dense>
+#include <vector>
+
+#include "symbolic/mbs/generated_model.hpp"
+
+namespace dydp::mbs {
+
+class ReducedDynamics {
+ public:
+  using Vector = Eigen::VectorXd;
+  using Matrix = Eigen::MatrixXd;
+
+  explicit ReducedDynamics(const GeneratedModel& model);
+  const GeneratedModel& model() const { return model_; }
+  int nu() const { return static_cast<int>(u_.size()); }
+
+  // The state of one evaluation, kept for its tangent.
+  struct Result {
+    Vector q, qd, qdd, lam;
+    Vector udd;
+    Matrix M;                                     // n x n
+    Matrix J;                                     // m x n
+    Eigen::PartialPivLU<Matrix> Jv;               // dependent columns of J
+    Matrix B;                                     // free coordinates x nu
+    Eigen::LLT<Matrix> reduced;                   // B^T M_ff B
+    int newton_iterations = 0;
+  };
+
+  // u, u_dot (nu), inputs, parameters (model sizes; p may be null for the model's values).
+  // `guess` holds a full q whose dependent coordinates start the Newton iteration.
+  // Throws std::runtime_error when Newton-Raphson does not converge.
+  void solve(const double* u, const double* ud, const double* inputs, const double* p, const Vector& guess,
+             Result& r) const;
+
+  // Derivatives of q, qd, qdd (n x nd each, column per direction) for seeds on u, u_dot
+  // (nu x nd), inputs (inputs x nd) and parameters (parameters x nd); null seeds are zero.
+  void tangent(const Result& r, const double* inputs, const double* p, int nd, const double* du,
+               const double* dud, const double* dinputs, const double* dp, Matrix& dq, Matrix& dqd,
+               Matrix& dqdd) const;
+
+  const std::vector<int>& independent() const { return u_; }
+  const std::vector<int>& dependent() const { return v_; }
+  const std::vector<int>& free() const { return f_; }
+
+ private:
+  const double* params(const double* p) const { return p ? p : (model_.parameters ? model_.parameter_values : pad_.data()); }
+  const GeneratedModel& model_;
+  std::vector<int> u_, v_, f_, d_;
+  std::vector<double> pad_;  // one zero for arrays of size zero
+};
+
+}  // namespace dydp::mbs
