@@ -1,0 +1,276 @@
+#include "gui/canvas.hpp"
+
+#include <QDragEnterEvent>
+#include <QKeyEvent>
+#include <QMimeData>
+#include <QScrollBar>
+#include <QWheelEvent>
+#include <set>
+
+namespace dydp::gui {
+namespace {
+
+QString q(const std::string& s) { return QString::fromStdString(s); }
+
+}  // namespace
+
+Canvas::Canvas(SceneController* controller, QWidget* parent)
+    : QGraphicsView(parent), controller_(controller) {
+  setScene(&scene_);
+  setAcceptDrops(true);
+  setRenderHint(QPainter::Antialiasing);
+  setDragMode(RubberBandDrag);
+  setBackgroundBrush(QColor(252, 252, 250));
+  scene_.setSceneRect(-2000, -2000, 6000, 6000);
+  connect(controller_, &SceneController::document_changed, this, &Canvas::sync);
+  connect(&scene_, &QGraphicsScene::selectionChanged, this, [this] {
+    const QStringList sel = selected_blocks();
+    emit selection_changed(sel.size() == 1 ? sel.front() : QString());
+  });
+  sync();
+}
+
+BlockItem* Canvas::block_item(const std::string& name) const {
+  const auto it = blocks_.find(name);
+  return it == blocks_.end() ? nullptr : it->second;
+}
+
+void Canvas::sync() {
+  const SceneDocument& doc = controller_->document();
+  // Blocks: keep items whose shape is unchanged (selection and error marks survive), remake others.
+  std::set<std::string> present;
+  for (const DocBlock& b : doc.blocks) {
+    present.insert(b.name);
+    const BlockPorts ports = controller_->ports(b.name);
+    BlockItem* item = block_item(b.name);
+    bool reselect = false;
+    if (item && !item->same_shape(b, ports)) {
+      // Settings changed the ports: remake the item (wires are remade below anyway).
+      reselect = item->isSelected();
+      for (WireItem* w : wires_) {
+        scene_.removeItem(w);
+        delete w;
+      }
+      wires_.clear();
+      scene_.removeItem(item);
+      delete item;
+      item = nullptr;
+      blocks_.erase(b.name);
+    }
+    if (!item) {
+      const engine::BlockType* type = engine::Registry::global().find(b.type);
+      item = new BlockItem(b, type ? type->summary : "unknown block type", ports);
+      const std::string name = b.name;
+      item->on_moved = [this, name] { update_wires_of(name); };
+      scene_.addItem(item);
+      blocks_[b.name] = item;
+      item->setSelected(reselect);
+    }
+    if (item->pos() != QPointF(b.x, b.y)) item->setPos(b.x, b.y);
+    item->set_logged(doc.outputs);
+  }
+  for (auto it = blocks_.begin(); it != blocks_.end();) {
+    if (present.count(it->first)) {
+      ++it;
+      continue;
+    }
+    scene_.removeItem(it->second);
+    delete it->second;
+    it = blocks_.erase(it);
+  }
+  // Wires: always redrawn from the connections.
+  for (WireItem* w : wires_) {
+    scene_.removeItem(w);
+    delete w;
+  }
+  wires_.clear();
+  for (const DocConnection& c : doc.connections) {
+    BlockItem* from = block_item(c.from.block);
+    BlockItem* to = block_item(c.to.block);
+    PortItem* pf = from ? from->port(c.from.port, false) : nullptr;
+    PortItem* pt = to ? to->port(c.to.port, true) : nullptr;
+    if (!pf || !pt) continue;  // the engine reports it when the scene is run
+    auto* w = new WireItem(c, pf, pt);
+    scene_.addItem(w);
+    wires_.push_back(w);
+  }
+}
+
+void Canvas::update_wires_of(const std::string& block) {
+  for (WireItem* w : wires_)
+    if (w->connection().from.block == block || w->connection().to.block == block) w->update_path();
+}
+
+QString Canvas::drop_block(const QString& type, QPointF pos) {
+  const QString name = controller_->add_block(type, pos);
+  if (name.isEmpty()) emit message(tr("unknown block type '%1'").arg(type));
+  else select_block(name);
+  return name;
+}
+
+QString Canvas::wire(const PortRef& a, bool a_is_input, const PortRef& b, bool b_is_input) {
+  // Dragging from an input to an output wires output -> input; same-direction pairs are refused
+  // by the controller with the reason.
+  const bool swap = a_is_input && !b_is_input;
+  const QString from = q(swap ? b.text() : a.text()), to = q(swap ? a.text() : b.text());
+  const QString why = controller_->connect_ports(from, to);
+  emit message(why.isEmpty() ? tr("wired %1 -> %2").arg(from, to) : tr("refused: %1").arg(why));
+  return why;
+}
+
+void Canvas::delete_selection() {
+  QStringList blocks;
+  std::vector<DocConnection> wires;
+  for (QGraphicsItem* item : scene_.selectedItems()) {
+    if (auto* b = qgraphicsitem_cast<BlockItem*>(item)) blocks << q(b->name());
+    if (auto* w = qgraphicsitem_cast<WireItem*>(item)) wires.push_back(w->connection());
+  }
+  controller_->undo_stack()->beginMacro(tr("Delete"));
+  if (!wires.empty()) controller_->remove_connections(wires);
+  if (!blocks.isEmpty()) controller_->remove_blocks(blocks);
+  controller_->undo_stack()->endMacro();
+}
+
+QStringList Canvas::selected_blocks() const {
+  QStringList out;
+  for (QGraphicsItem* item : scene_.selectedItems())
+    if (auto* b = qgraphicsitem_cast<BlockItem*>(item)) out << q(b->name());
+  return out;
+}
+
+void Canvas::select_block(const QString& name) {
+  scene_.clearSelection();
+  if (BlockItem* b = block_item(name.toStdString())) b->setSelected(true);
+}
+
+void Canvas::show_error(const QStringList& blocks, const QString& message) {
+  clear_errors();
+  for (const QString& name : blocks)
+    if (BlockItem* b = block_item(name.toStdString())) {
+      b->set_error(message);
+      ensureVisible(b);
+    }
+}
+
+void Canvas::clear_errors() {
+  for (auto& [name, item] : blocks_) item->set_error({});
+}
+
+void Canvas::set_notes(const std::map<std::string, QString>& notes) {
+  for (auto& [name, item] : blocks_) {
+    const auto it = notes.find(name);
+    item->set_note(it == notes.end() ? QString() : it->second);
+  }
+}
+
+void Canvas::fit_all() {
+  QRectF r = scene_.itemsBoundingRect();
+  if (r.isEmpty()) return;
+  r.adjust(-30, -30, 30, 30);
+  fitInView(r, Qt::KeepAspectRatio);
+  // Never magnify: text stays at its natural size when the diagram is small.
+  if (transform().m11() > 1.0) resetTransform();
+  centerOn(r.center());
+}
+
+PortItem* Canvas::port_at(QPoint view_pos) const {
+  for (QGraphicsItem* item : items(view_pos))
+    if (auto* p = qgraphicsitem_cast<PortItem*>(item)) return p;
+  return nullptr;
+}
+
+void Canvas::dragEnterEvent(QDragEnterEvent* e) {
+  if (e->mimeData()->hasFormat(kBlockTypeMime)) e->acceptProposedAction();
+  else QGraphicsView::dragEnterEvent(e);
+}
+
+void Canvas::dragMoveEvent(QDragMoveEvent* e) {
+  if (e->mimeData()->hasFormat(kBlockTypeMime)) e->acceptProposedAction();
+  else QGraphicsView::dragMoveEvent(e);
+}
+
+void Canvas::dropEvent(QDropEvent* e) {
+  if (!e->mimeData()->hasFormat(kBlockTypeMime)) return QGraphicsView::dropEvent(e);
+  const QString type = QString::fromUtf8(e->mimeData()->data(kBlockTypeMime));
+  drop_block(type, mapToScene(e->position().toPoint()));
+  e->acceptProposedAction();
+}
+
+void Canvas::mousePressEvent(QMouseEvent* e) {
+  if (e->button() == Qt::LeftButton) {
+    if (PortItem* p = port_at(e->pos())) {
+      drag_from_ = p;
+      drag_wire_ = scene_.addPath(wire_path(p->anchor(), p->anchor()), QPen(QColor(30, 100, 220), 1.8, Qt::DashLine));
+      return;
+    }
+  }
+  QGraphicsView::mousePressEvent(e);
+}
+
+void Canvas::mouseMoveEvent(QMouseEvent* e) {
+  if (!drag_from_) return QGraphicsView::mouseMoveEvent(e);
+  const QPointF at = mapToScene(e->pos());
+  const QPointF a = drag_from_->anchor();
+  drag_wire_->setPath(drag_from_->is_input() ? wire_path(at, a) : wire_path(a, at));
+  PortItem* over = port_at(e->pos());
+  if (over == drag_from_) over = nullptr;
+  if (over != drag_over_) {
+    if (drag_over_) drag_over_->set_drop_state(0);
+    drag_over_ = over;
+    if (over) {
+      // Tell at once whether the wire would be accepted, and why not.
+      const bool swap = drag_from_->is_input() && !over->is_input();
+      const QString why = controller_->check_connection(q((swap ? over : drag_from_)->ref().text()),
+                                                        q((swap ? drag_from_ : over)->ref().text()));
+      over->set_drop_state(why.isEmpty() ? 1 : -1);
+      emit message(why.isEmpty() ? tr("release to wire") : tr("refused: %1").arg(why));
+    }
+  }
+}
+
+void Canvas::mouseReleaseEvent(QMouseEvent* e) {
+  if (!drag_from_) {
+    QGraphicsView::mouseReleaseEvent(e);
+    commit_moves();
+    return;
+  }
+  PortItem* from = drag_from_;
+  PortItem* over = port_at(e->pos());
+  if (drag_over_) drag_over_->set_drop_state(0);
+  scene_.removeItem(drag_wire_);
+  delete drag_wire_;
+  drag_wire_ = nullptr;
+  drag_from_ = drag_over_ = nullptr;
+  if (over && over != from) wire(from->ref(), from->is_input(), over->ref(), over->is_input());
+}
+
+void Canvas::commit_moves() {
+  // Blocks dragged with the mouse: one undo step for all that moved.
+  std::vector<std::pair<QString, QPointF>> moved;
+  for (const DocBlock& b : controller_->document().blocks)
+    if (BlockItem* item = block_item(b.name); item && item->pos() != QPointF(b.x, b.y))
+      moved.emplace_back(q(b.name), item->pos());
+  if (moved.empty()) return;
+  controller_->undo_stack()->beginMacro(tr("Move"));
+  for (const auto& [name, pos] : moved) controller_->move_block(name, pos);
+  controller_->undo_stack()->endMacro();
+}
+
+void Canvas::keyPressEvent(QKeyEvent* e) {
+  if (e->key() == Qt::Key_Delete || e->key() == Qt::Key_Backspace) {
+    delete_selection();
+    return;
+  }
+  QGraphicsView::keyPressEvent(e);
+}
+
+void Canvas::wheelEvent(QWheelEvent* e) {
+  if (e->modifiers() & Qt::ControlModifier) {
+    const double f = e->angleDelta().y() > 0 ? 1.15 : 1 / 1.15;
+    scale(f, f);
+    return;
+  }
+  QGraphicsView::wheelEvent(e);
+}
+
+}  // namespace dydp::gui

@@ -1,0 +1,58 @@
+// dydp-gui: edit and run dydp scenes as block diagrams.
+//   dydp-gui [SCENE] [--run] [--screenshot FILE.png]
+// With --screenshot the window is shown, the scene run (with --run) and the window saved as an
+// image, then the program exits (used by scripts/gui_screenshot.sh).
+#include <QApplication>
+#include <QCommandLineParser>
+#include <QScreen>
+#include <QTimer>
+#include <cstdio>
+
+#include "gui/main_window.hpp"
+
+int main(int argc, char** argv) {
+  QApplication app(argc, argv);
+  QApplication::setApplicationName("dydp-gui");
+  QCommandLineParser cli;
+  cli.setApplicationDescription("Edit and run dydp scenes as block diagrams.");
+  cli.addHelpOption();
+  cli.addPositionalArgument("scene", "scene file to open");
+  const QCommandLineOption run_option("run", "run the scene once opened");
+  const QCommandLineOption shot_option("screenshot", "save the window to FILE and exit", "FILE");
+  const QCommandLineOption size_option("size", "window size WxH", "WxH", "1600x1000");
+  cli.addOptions({run_option, shot_option, size_option});
+  cli.process(app);
+
+  dydp::gui::MainWindow window;
+  const QStringList size = cli.value(size_option).split('x');
+  if (size.size() == 2) window.resize(size[0].toInt(), size[1].toInt());
+  window.show();
+  const QStringList args = cli.positionalArguments();
+  if (!args.isEmpty() && !window.open_file(args.front(), cli.isSet(shot_option))) {
+    std::fprintf(stderr, "%s\n", window.last_error().toUtf8().constData());
+    if (cli.isSet(shot_option)) return 2;
+  }
+  const QString shot = cli.value(shot_option);
+  auto take_shot = [&] {
+    QTimer::singleShot(300, &window, [&] {
+      window.canvas()->fit_all();
+      QApplication::processEvents();
+      const bool ok = window.grab().save(shot);
+      if (!ok) std::fprintf(stderr, "cannot write %s\n", shot.toUtf8().constData());
+      QApplication::exit(ok ? 0 : 1);
+    });
+  };
+  if (cli.isSet(run_option)) {
+    QTimer::singleShot(200, &window, [&] {
+      if (!window.start_run()) {
+        std::fprintf(stderr, "%s\n", window.last_error().toUtf8().constData());
+        if (!shot.isEmpty()) take_shot();
+      }
+    });
+    if (!shot.isEmpty())
+      QObject::connect(&window, &dydp::gui::MainWindow::run_ended, &window, [&] { take_shot(); });
+  } else if (!shot.isEmpty()) {
+    take_shot();
+  }
+  return app.exec();
+}

@@ -1,0 +1,219 @@
+#include "gui/main_window.hpp"
+
+#include <QApplication>
+#include <QCloseEvent>
+#include <QDockWidget>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QStatusBar>
+#include <QTabWidget>
+#include <QToolBar>
+
+#include "engine/errors.hpp"
+
+namespace dydp::gui {
+
+MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
+  canvas_ = new Canvas(&controller_);
+  setCentralWidget(canvas_);
+
+  palette_ = new Palette;
+  auto* palette_dock = new QDockWidget(tr("Blocks"));
+  palette_dock->setObjectName("palette");
+  palette_dock->setWidget(palette_);
+  addDockWidget(Qt::LeftDockWidgetArea, palette_dock);
+
+  properties_ = new PropertyEditor(&controller_);
+  scene_panel_ = new ScenePanel(&controller_);
+  auto* tabs = new QTabWidget;
+  tabs->addTab(properties_, tr("Block"));
+  tabs->addTab(scene_panel_, tr("Scene"));
+  auto* right_dock = new QDockWidget(tr("Properties"));
+  right_dock->setObjectName("properties");
+  right_dock->setWidget(tabs);
+  addDockWidget(Qt::RightDockWidgetArea, right_dock);
+
+  results_ = new ResultsPanel;
+  auto* results_dock = new QDockWidget(tr("Results"));
+  results_dock->setObjectName("results");
+  results_dock->setWidget(results_);
+  addDockWidget(Qt::BottomDockWidgetArea, results_dock);
+
+  // Actions.
+  auto* file = menuBar()->addMenu(tr("&File"));
+  auto* edit = menuBar()->addMenu(tr("&Edit"));
+  auto* run_menu = menuBar()->addMenu(tr("&Run"));
+  auto* tools = addToolBar(tr("Main"));
+  tools->setObjectName("main_toolbar");
+  auto* act_new = file->addAction(tr("&New"), QKeySequence::New, this, [this] {
+    if (maybe_save()) controller_.new_scene();
+  });
+  auto* act_open = file->addAction(tr("&Open..."), QKeySequence::Open, this, [this] {
+    if (!maybe_save()) return;
+    const QString path = QFileDialog::getOpenFileName(this, tr("Open scene"), {}, tr("Scenes (*.yaml *.yml)"));
+    if (!path.isEmpty()) open_file(path);
+  });
+  auto* act_save = file->addAction(tr("&Save"), QKeySequence::Save, this, [this] {
+    QString path = controller_.file_path();
+    if (path.isEmpty()) path = QFileDialog::getSaveFileName(this, tr("Save scene"), {}, tr("Scenes (*.yaml)"));
+    if (!path.isEmpty()) save_file(path);
+  });
+  file->addAction(tr("Save &as..."), QKeySequence::SaveAs, this, [this] {
+    const QString path = QFileDialog::getSaveFileName(this, tr("Save scene"), controller_.file_path(), tr("Scenes (*.yaml)"));
+    if (!path.isEmpty()) save_file(path);
+  });
+  file->addSeparator();
+  file->addAction(tr("&Quit"), QKeySequence::Quit, this, &QWidget::close);
+  QAction* undo = controller_.undo_stack()->createUndoAction(this, tr("&Undo"));
+  undo->setShortcut(QKeySequence::Undo);
+  QAction* redo = controller_.undo_stack()->createRedoAction(this, tr("&Redo"));
+  redo->setShortcut(QKeySequence::Redo);
+  edit->addAction(undo);
+  edit->addAction(redo);
+  auto* act_delete = edit->addAction(tr("&Delete"), this, [this] { canvas_->delete_selection(); });
+  edit->addAction(tr("&Fit diagram"), this, [this] { canvas_->fit_all(); });
+  run_action_ = run_menu->addAction(tr("&Run"), QKeySequence(Qt::Key_F5), this, [this] { start_run(); });
+  cancel_action_ = run_menu->addAction(tr("&Cancel"), QKeySequence(Qt::Key_Escape), this, [this] { worker_.cancel(); });
+  cancel_action_->setEnabled(false);
+  for (QAction* a : {act_new, act_open, act_save}) tools->addAction(a);
+  tools->addSeparator();
+  tools->addAction(undo);
+  tools->addAction(redo);
+  tools->addAction(act_delete);
+  tools->addSeparator();
+  tools->addAction(run_action_);
+  tools->addAction(cancel_action_);
+  progress_ = new QProgressBar;
+  progress_->setRange(0, 1000);
+  progress_->setValue(0);
+  progress_->setMaximumWidth(220);
+  progress_->setFormat("%p%");
+  tools->addWidget(progress_);
+
+  status_label_ = new QLabel;
+  statusBar()->addWidget(status_label_, 1);
+
+  connect(canvas_, &Canvas::message, this, &MainWindow::status);
+  connect(properties_, &PropertyEditor::message, this, &MainWindow::status);
+  connect(scene_panel_, &ScenePanel::message, this, &MainWindow::status);
+  connect(canvas_, &Canvas::selection_changed, this, [this, tabs](const QString& block) {
+    properties_->set_block(block);
+    if (!block.isEmpty()) tabs->setCurrentWidget(properties_);
+  });
+  connect(palette_, &Palette::activated_type, this, [this](const QString& type) {
+    const QRectF r = canvas_->mapToScene(canvas_->viewport()->rect()).boundingRect();
+    canvas_->drop_block(type, r.center() - QPointF(75, 40));
+  });
+  connect(&controller_, &SceneController::file_changed, this, &MainWindow::update_title);
+  connect(controller_.undo_stack(), &QUndoStack::cleanChanged, this, &MainWindow::update_title);
+  connect(&controller_, &SceneController::document_changed, this, [this] { canvas_->clear_errors(); });
+  connect(&worker_, &RunWorker::progress, this, [this](double f) { progress_->setValue(static_cast<int>(f * 1000)); });
+  connect(&worker_, &RunWorker::finished, this, &MainWindow::run_finished);
+  resize(1500, 950);
+  update_title();
+}
+
+void MainWindow::status(const QString& text) { status_label_->setText(text); }
+
+void MainWindow::update_title() {
+  const QString path = controller_.file_path();
+  setWindowTitle(QString("%1%2 - dydp").arg(path.isEmpty() ? tr("untitled") : QFileInfo(path).fileName(),
+                                             controller_.modified() ? "*" : ""));
+}
+
+bool MainWindow::open_file(const QString& path, bool quiet) {
+  try {
+    controller_.open(path);
+  } catch (const engine::InputError& e) {
+    last_error_ = QString::fromUtf8(e.what());
+    if (!quiet) QMessageBox::warning(this, tr("Cannot open scene"), last_error_);
+    status(last_error_);
+    return false;
+  }
+  results_->clear();
+  canvas_->fit_all();
+  status(tr("opened %1").arg(path));
+  return true;
+}
+
+bool MainWindow::save_file(const QString& path) {
+  try {
+    controller_.save(path);
+  } catch (const std::exception& e) {
+    QMessageBox::warning(this, tr("Cannot save scene"), QString::fromUtf8(e.what()));
+    return false;
+  }
+  status(tr("saved %1").arg(path));
+  return true;
+}
+
+bool MainWindow::maybe_save() {
+  if (!controller_.modified()) return true;
+  const auto answer = QMessageBox::question(this, tr("Unsaved changes"), tr("Save the changes to this scene?"),
+                                            QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel);
+  if (answer == QMessageBox::Cancel) return false;
+  if (answer == QMessageBox::Discard) return true;
+  QString path = controller_.file_path();
+  if (path.isEmpty()) path = QFileDialog::getSaveFileName(this, tr("Save scene"), {}, tr("Scenes (*.yaml)"));
+  return !path.isEmpty() && save_file(path);
+}
+
+void MainWindow::closeEvent(QCloseEvent* e) {
+  if (!maybe_save()) return e->ignore();
+  worker_.cancel();
+  e->accept();
+}
+
+bool MainWindow::start_run() {
+  if (worker_.running()) return false;
+  canvas_->clear_errors();
+  canvas_->set_notes({});
+  engine::Diagram d;
+  try {
+    d = controller_.load_for_run();
+  } catch (const engine::InputError& e) {
+    last_error_ = QString::fromUtf8(e.what());
+    const QStringList blocks = controller_.blocks_of_error(e);
+    canvas_->show_error(blocks, last_error_);
+    if (blocks.size() == 1) canvas_->select_block(blocks.front());
+    status(tr("invalid scene: %1").arg(last_error_));
+    return false;
+  }
+  last_error_.clear();
+  progress_->setValue(0);
+  run_action_->setEnabled(false);
+  cancel_action_->setEnabled(true);
+  status(tr("running..."));
+  worker_.start(std::move(d));
+  return true;
+}
+
+void MainWindow::run_finished(const RunOutcome& outcome) {
+  run_action_->setEnabled(true);
+  cancel_action_->setEnabled(false);
+  switch (outcome.status) {
+    case RunOutcome::Status::finished: {
+      progress_->setValue(1000);
+      results_->show_result(outcome.result);
+      std::map<std::string, QString> notes;
+      for (const auto& o : outcome.result->objectives) notes[o.name] = QString("ψ = %1").arg(o.value, 0, 'g', 6);
+      canvas_->set_notes(notes);
+      const auto& st = outcome.result->stats;
+      status(tr("done: %1 steps, %2 s CPU").arg(st.steps).arg(st.cpu_seconds, 0, 'g', 3));
+      break;
+    }
+    case RunOutcome::Status::cancelled:
+      status(tr("run cancelled"));
+      break;
+    case RunOutcome::Status::failed:
+      last_error_ = outcome.message;
+      if (!outcome.block.isEmpty()) canvas_->show_error({outcome.block}, outcome.message);
+      status(tr("solver failure: %1").arg(outcome.message));
+      break;
+  }
+  emit run_ended(outcome);
+}
+
+}  // namespace dydp::gui

@@ -1,0 +1,69 @@
+// The main window: palette (left), canvas (centre), block and scene panels (right), results
+// (bottom); File, Edit and Run actions; runs go to a worker thread with progress and cancel.
+#pragma once
+
+#include <QAction>
+#include <QLabel>
+#include <QMainWindow>
+#include <QProgressBar>
+
+#include "gui/canvas.hpp"
+#include "gui/palette.hpp"
+#include "gui/property_editor.hpp"
+#include "gui/results_panel.hpp"
+#include "gui/run_worker.hpp"
+#include "gui/scene_controller.hpp"
+#include "gui/scene_panel.hpp"
+
+namespace dydp::gui {
+
+class MainWindow : public QMainWindow {
+  Q_OBJECT
+
+ public:
+  explicit MainWindow(QWidget* parent = nullptr);
+
+  SceneController* controller() { return &controller_; }
+  Canvas* canvas() { return canvas_; }
+  Palette* palette() { return palette_; }
+  PropertyEditor* property_editor() { return properties_; }
+  ScenePanel* scene_panel() { return scene_panel_; }
+  ResultsPanel* results() { return results_; }
+  RunWorker* worker() { return &worker_; }
+  QProgressBar* progress_bar() { return progress_; }
+
+  /// Opens a scene; false (with a message box unless quiet) when it is not a scene.
+  bool open_file(const QString& path, bool quiet = false);
+  bool save_file(const QString& path);
+  /// Validates and starts a run; false when validation failed (the block is marked).
+  bool start_run();
+  /// The last validation or solver error shown, "" after a successful run.
+  const QString& last_error() const { return last_error_; }
+
+ signals:
+  void run_ended(const dydp::gui::RunOutcome& outcome);
+
+ protected:
+  void closeEvent(QCloseEvent* e) override;
+
+ private:
+  bool maybe_save();
+  void update_title();
+  void run_finished(const RunOutcome& outcome);
+  void status(const QString& text);
+
+  SceneController controller_;
+  RunWorker worker_;
+  Canvas* canvas_;
+  Palette* palette_;
+  PropertyEditor* properties_;
+  ScenePanel* scene_panel_;
+  ResultsPanel* results_;
+  QProgressBar* progress_;
+  QAction* run_action_;
+  QAction* cancel_action_;
+  QLabel* status_label_;
+  QString last_error_;
+};
+
+}  // namespace dydp::gui

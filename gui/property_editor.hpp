@@ -1,0 +1,45 @@
+// The property editor of the selected block: its name, type and summary; its parameters
+// (value or $scene_parameter, unit, default, bounds) and settings; which outputs are logged.
+// A refused value is reverted and the reason shown under the table.
+#pragma once
+
+#include <QLabel>
+#include <QLineEdit>
+#include <QListWidget>
+#include <QTableWidget>
+#include <QWidget>
+
+#include "gui/scene_controller.hpp"
+
+namespace dydp::gui {
+
+class PropertyEditor : public QWidget {
+  Q_OBJECT
+
+ public:
+  explicit PropertyEditor(SceneController* controller, QWidget* parent = nullptr);
+  void set_block(const QString& name);
+  const QString& block() const { return block_; }
+  /// Applies text to the parameter or setting in `row` as if typed; returns the refusal or "".
+  QString edit_value(const QString& key, const QString& text);
+  QTableWidget* table() { return table_; }
+
+ public slots:
+  void refresh();
+
+ signals:
+  void message(const QString& text);
+
+ private:
+  SceneController* controller_;
+  QString block_;
+  QLineEdit* name_;
+  QLabel* type_;
+  QLabel* summary_;
+  QTableWidget* table_;
+  QListWidget* outputs_;
+  QLabel* status_;
+  bool refreshing_ = false;
+};
+
+}  // namespace dydp::gui

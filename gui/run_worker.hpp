@@ -1,0 +1,53 @@
+// Runs a loaded diagram in a worker thread: progress as a fraction of the time span, a cancel
+// that stops the solver at the next output time, and the result (or the failure) delivered
+// back on the thread that owns the worker.
+#pragma once
+
+#include <QObject>
+#include <QString>
+#include <QThread>
+#include <atomic>
+#include <memory>
+
+#include "engine/diagram.hpp"
+#include "engine/run.hpp"
+
+namespace dydp::gui {
+
+struct RunOutcome {
+  enum class Status { finished, cancelled, failed };
+  Status status = Status::failed;
+  QString message;                             ///< the failure ("t = T s: block B: reason")
+  QString block;                               ///< the block a solver failure names, if any
+  std::shared_ptr<const engine::Diagram> diagram;
+  std::shared_ptr<const engine::RunResult> result;  ///< set when finished
+};
+
+class RunWorker : public QObject {
+  Q_OBJECT
+
+ public:
+  explicit RunWorker(QObject* parent = nullptr);
+  ~RunWorker() override;
+
+  /// Starts running d; false when a run is already going on.
+  bool start(engine::Diagram d, bool sensitivities = true);
+  /// Asks the running solver to stop at its next output time; finished() follows (cancelled).
+  void cancel();
+  bool running() const { return thread_ != nullptr; }
+  /// Blocks until the current run (if any) has ended and finished() was emitted.
+  void wait();
+
+ signals:
+  void progress(double fraction);
+  void finished(const dydp::gui::RunOutcome& outcome);
+
+ private:
+  void deliver(RunOutcome outcome);
+  QThread* thread_ = nullptr;
+  std::shared_ptr<std::atomic<bool>> cancel_;
+};
+
+}  // namespace dydp::gui
+
+Q_DECLARE_METATYPE(dydp::gui::RunOutcome)

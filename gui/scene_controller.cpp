@@ -1,0 +1,469 @@
+#include "gui/scene_controller.hpp"
+
+#include <QDir>
+#include <QFileInfo>
+#include <QRegularExpression>
+#include <QTemporaryFile>
+#include <QUndoCommand>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace dydp::gui {
+
+/// One undo step: the document before and after the edit.
+class DocumentEdit : public QUndoCommand {
+ public:
+  DocumentEdit(SceneController* c, const QString& label, SceneDocument before, SceneDocument after)
+      : QUndoCommand(label), c_(c), before_(std::move(before)), after_(std::move(after)) {}
+  void undo() override { c_->replace(before_); }
+  void redo() override { c_->replace(after_); }
+
+ private:
+  SceneController* c_;
+  SceneDocument before_, after_;
+};
+
+namespace {
+
+std::string s(const QString& q) { return q.toStdString(); }
+QString q(const std::string& s) { return QString::fromStdString(s); }
+
+std::string number_text(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
+bool valid_name(const std::string& name) {
+  return !name.empty() && name.find_first_of(". \t:#$[]{},") == std::string::npos;
+}
+
+const engine::PortDecl* find_port(const std::vector<engine::PortDecl>& ports, const std::string& name) {
+  for (const auto& p : ports)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+}  // namespace
+
+SceneController::SceneController(QObject* parent) : QObject(parent) { new_scene(); }
+
+void SceneController::new_scene() {
+  SceneDocument doc;
+  doc.scene = "untitled";
+  doc.time = {{"start", "0.0"}, {"stop", "10.0"}, {"output_step", "0.01"}};
+  doc.solver = {{"method", "bdf"}, {"rtol", "1.0e-6"}, {"atol", "1.0e-8"}};
+  undo_.clear();
+  path_.clear();
+  replace(doc);
+  emit file_changed();
+}
+
+void SceneController::open(const QString& path) {
+  SceneDocument doc = read_scene_file(s(path));
+  place_unplaced_blocks(doc);
+  undo_.clear();
+  path_ = path;
+  replace(doc);
+  emit file_changed();
+}
+
+void SceneController::save(const QString& path) {
+  write_scene_file(doc_, s(path));
+  path_ = path;
+  undo_.setClean();
+  emit file_changed();
+}
+
+void SceneController::replace(const SceneDocument& doc) {
+  doc_ = doc;
+  emit document_changed();
+}
+
+void SceneController::commit(const QString& label, SceneDocument after) {
+  if (after == doc_) return;
+  undo_.push(new DocumentEdit(this, label, doc_, std::move(after)));
+}
+
+const engine::BlockType* SceneController::type_of(const std::string& block) const {
+  const DocBlock* b = doc_.find_block(block);
+  return b ? engine::Registry::global().find(b->type) : nullptr;
+}
+
+BlockPorts SceneController::ports(const std::string& block) const {
+  const DocBlock* b = doc_.find_block(block);
+  const engine::BlockType* type = b ? engine::Registry::global().find(b->type) : nullptr;
+  if (!type) {
+    BlockPorts none;
+    none.error = b ? "unknown block type '" + b->type + "'" : "no block '" + block + "'";
+    return none;
+  }
+  std::string key = b->type;
+  for (const auto& spec : type->settings)
+    if (const SceneValue* v = b->find(spec.name)) key += "\n" + spec.name + "=" + v->text();
+  auto it = ports_cache_.find(key);
+  if (it == ports_cache_.end()) it = ports_cache_.emplace(key, ports_of(*type, *b)).first;
+  return it->second;
+}
+
+void SceneController::place_unplaced_blocks(SceneDocument& doc) const {
+  // Columns by signal flow: a block sits one column right of the furthest block driving it
+  // (longest path from the sources; cycles stop growing after as many rounds as blocks).
+  std::map<std::string, int> column;
+  for (const auto& b : doc.blocks) column[b.name] = 0;
+  for (size_t round = 0; round < doc.blocks.size(); ++round) {
+    bool changed = false;
+    for (const auto& c : doc.connections) {
+      if (!column.count(c.from.block) || !column.count(c.to.block) || c.from.block == c.to.block) continue;
+      const int want = column[c.from.block] + 1;
+      if (column[c.to.block] < want && want < static_cast<int>(doc.blocks.size())) {
+        column[c.to.block] = want;
+        changed = true;
+      }
+    }
+    if (!changed) break;
+  }
+  std::map<int, int> rows;
+  for (auto& b : doc.blocks) {
+    const int col = column[b.name];
+    const int row = rows[col]++;
+    if (b.placed) continue;
+    b.x = 40 + 260 * col;
+    b.y = 40 + 170 * row;
+    b.placed = true;
+  }
+}
+
+QString SceneController::add_block(const QString& type_name, QPointF pos) {
+  const engine::BlockType* type = engine::Registry::global().find(s(type_name));
+  if (!type) return {};
+  SceneDocument after = doc_;
+  DocBlock b;
+  b.type = type->name;
+  b.name = doc_.unique_block_name(name_stem(type->name));
+  b.x = std::round(pos.x());
+  b.y = std::round(pos.y());
+  b.placed = true;
+  // Required parameters start at their default so the scene stays loadable.
+  for (const auto& p : type->parameters)
+    if (p.required) b.set(p.name, SceneValue::scalar(number_text(p.default_value)));
+  after.blocks.push_back(b);
+  commit(tr("Add %1").arg(q(b.name)), std::move(after));
+  return q(b.name);
+}
+
+void SceneController::remove_blocks(const QStringList& names) {
+  SceneDocument after = doc_;
+  for (const QString& qn : names) {
+    const std::string name = s(qn);
+    std::erase_if(after.blocks, [&](const DocBlock& b) { return b.name == name; });
+    std::erase_if(after.connections,
+                  [&](const DocConnection& c) { return c.from.block == name || c.to.block == name; });
+    std::erase_if(after.outputs, [&](const std::string& o) {
+      PortRef r;
+      return o == name || (PortRef::parse(o, r) && r.block == name);
+    });
+  }
+  commit(names.size() == 1 ? tr("Delete %1").arg(names.front()) : tr("Delete %1 blocks").arg(names.size()),
+         std::move(after));
+}
+
+void SceneController::move_block(const QString& name, QPointF pos) {
+  SceneDocument after = doc_;
+  DocBlock* b = after.find_block(s(name));
+  if (!b) return;
+  b->x = std::round(pos.x());
+  b->y = std::round(pos.y());
+  b->placed = true;
+  commit(tr("Move %1").arg(name), std::move(after));
+}
+
+QString SceneController::check_connection(const QString& from_text, const QString& to_text) const {
+  PortRef from, to;
+  if (!PortRef::parse(s(from_text), from) || !PortRef::parse(s(to_text), to))
+    return tr("both ends need block.port");
+  if (!doc_.find_block(from.block)) return tr("no block '%1'").arg(q(from.block));
+  if (!doc_.find_block(to.block)) return tr("no block '%1'").arg(q(to.block));
+  const BlockPorts pf = ports(from.block), pt = ports(to.block);
+  if (!pf.error.empty()) return q(from.block + ": " + pf.error);
+  if (!pt.error.empty()) return q(to.block + ": " + pt.error);
+  const engine::PortDecl* out = find_port(pf.outputs, from.port);
+  const engine::PortDecl* in = find_port(pt.inputs, to.port);
+  if (!out)
+    return find_port(pf.inputs, from.port)
+               ? tr("%1 is an input: a wire runs from an output to an input").arg(from_text)
+               : tr("block '%1' has no output '%2'").arg(q(from.block), q(from.port));
+  if (!in)
+    return find_port(pt.outputs, to.port)
+               ? tr("%1 is an output: a wire runs from an output to an input").arg(to_text)
+               : tr("block '%1' has no input '%2'").arg(q(to.block), q(to.port));
+  if (out->width != in->width)
+    return tr("width mismatch: %1 has width %2, %3 expects %4")
+        .arg(from_text).arg(out->width).arg(to_text).arg(in->width);
+  if (const DocConnection* c = doc_.driver_of(to))
+    return tr("%1 is already driven by %2").arg(to_text, q(c->from.text()));
+  return {};
+}
+
+QString SceneController::connect_ports(const QString& from, const QString& to) {
+  const QString why = check_connection(from, to);
+  if (!why.isEmpty()) return why;
+  SceneDocument after = doc_;
+  DocConnection c;
+  PortRef::parse(s(from), c.from);
+  PortRef::parse(s(to), c.to);
+  after.connections.push_back(c);
+  commit(tr("Connect %1 -> %2").arg(from, to), std::move(after));
+  return {};
+}
+
+void SceneController::remove_connections(const std::vector<DocConnection>& connections) {
+  SceneDocument after = doc_;
+  std::erase_if(after.connections, [&](const DocConnection& c) {
+    return std::find(connections.begin(), connections.end(), c) != connections.end();
+  });
+  commit(tr("Delete wire"), std::move(after));
+}
+
+void SceneController::drop_dangling(SceneDocument& doc, const std::string& block) const {
+  // ports() reads doc_, so ask with a controller-independent lookup of the edited block.
+  const DocBlock* b = doc.find_block(block);
+  const engine::BlockType* type = b ? engine::Registry::global().find(b->type) : nullptr;
+  if (!type) return;
+  const BlockPorts p = ports_of(*type, *b);
+  auto width_of = [&](const std::string& other, const std::string& port, bool input) -> int {
+    if (other == block) {
+      const engine::PortDecl* d = find_port(input ? p.inputs : p.outputs, port);
+      return d ? d->width : -1;
+    }
+    const BlockPorts op = ports(other);
+    const engine::PortDecl* d = find_port(input ? op.inputs : op.outputs, port);
+    return d ? d->width : -1;
+  };
+  std::erase_if(doc.connections, [&](const DocConnection& c) {
+    if (c.from.block != block && c.to.block != block) return false;
+    const int wf = width_of(c.from.block, c.from.port, false), wt = width_of(c.to.block, c.to.port, true);
+    return wf < 0 || wt < 0 || wf != wt;
+  });
+  std::erase_if(doc.outputs, [&](const std::string& o) {
+    PortRef r;
+    return PortRef::parse(o, r) && r.block == block && !find_port(p.outputs, r.port);
+  });
+}
+
+QString SceneController::set_block_value(const QString& block_name, const QString& key_q,
+                                         const QString& text_q) {
+  const std::string key = s(key_q), text = s(text_q).empty() ? "" : SceneValue::parse(s(text_q)).text();
+  SceneDocument after = doc_;
+  DocBlock* b = after.find_block(s(block_name));
+  if (!b) return tr("no block '%1'").arg(block_name);
+  const engine::BlockType* type = engine::Registry::global().find(b->type);
+  if (!type) return tr("unknown block type '%1'").arg(q(b->type));
+  const QString field = block_name + "." + key_q;
+
+  if (const int j = parameter_index(*type, key); j >= 0) {
+    const engine::ParamSpec& spec = type->parameters[j];
+    if (text.empty() && spec.required) return tr("%1: required parameter").arg(field);
+    if (!text.empty() && text[0] == '$') {
+      const DocParameter* sp = doc_.find_parameter(text.substr(1));
+      if (!sp) return tr("%1: unknown scene parameter '%2'").arg(field, q(text));
+      const bool direction = std::find(doc_.sensitivities.begin(), doc_.sensitivities.end(), sp->name) !=
+                             doc_.sensitivities.end();
+      if (!spec.differentiable && direction)
+        return tr("%1: not differentiable, cannot be driven by sensitivity parameter '%2'")
+            .arg(field, q(sp->name));
+    } else if (!text.empty()) {
+      double v = 0;
+      if (!engine::parse_number(text, v)) return tr("%1: malformed number '%2'").arg(field, q(text));
+      if (v < spec.lower || v > spec.upper)
+        return tr("%1: value %2 outside [%3, %4] %5")
+            .arg(field, q(text)).arg(spec.lower).arg(spec.upper).arg(q(spec.unit)).trimmed();
+    }
+    b->set(key, SceneValue::scalar(text));
+  } else if (setting_index(*type, key) >= 0) {
+    b->set(key, text.empty() ? SceneValue::scalar("") : SceneValue::parse(text));
+    const BlockPorts p = ports_of(*type, *b);
+    if (!p.error.empty()) return q(p.error);
+    drop_dangling(after, b->name);
+  } else {
+    std::string known;
+    for (const auto& p : type->parameters) known += " " + p.name;
+    for (const auto& p : type->settings) known += " " + p.name;
+    return tr("%1: unknown parameter of %2 (known:%3)").arg(field, q(type->name), q(known));
+  }
+  commit(tr("Set %1").arg(field), std::move(after));
+  return {};
+}
+
+QString SceneController::rename_block(const QString& from_q, const QString& to_q) {
+  const std::string from = s(from_q), to = s(to_q);
+  if (from == to) return {};
+  if (!valid_name(to)) return tr("block name '%1' must be non-empty, without '.', spaces or YAML marks").arg(to_q);
+  if (doc_.find_block(to)) return tr("a block named '%1' exists").arg(to_q);
+  SceneDocument after = doc_;
+  DocBlock* b = after.find_block(from);
+  if (!b) return tr("no block '%1'").arg(from_q);
+  b->name = to;
+  for (auto& c : after.connections) {
+    if (c.from.block == from) c.from.block = to;
+    if (c.to.block == from) c.to.block = to;
+  }
+  for (auto& o : after.outputs) {
+    PortRef r;
+    if (o == from) o = to;
+    else if (PortRef::parse(o, r) && r.block == from) o = to + "." + r.port;
+  }
+  commit(tr("Rename %1 to %2").arg(from_q, to_q), std::move(after));
+  return {};
+}
+
+void SceneController::set_output(const QString& ref_q, bool logged) {
+  const std::string ref = s(ref_q);
+  SceneDocument after = doc_;
+  const auto it = std::find(after.outputs.begin(), after.outputs.end(), ref);
+  if (logged && it == after.outputs.end()) after.outputs.push_back(ref);
+  if (!logged && it != after.outputs.end()) after.outputs.erase(it);
+  commit(logged ? tr("Log %1").arg(ref_q) : tr("Stop logging %1").arg(ref_q), std::move(after));
+}
+
+QString SceneController::set_time(const QString& key, const QString& text) {
+  double v = 0;
+  if (!text.isEmpty() && !engine::parse_number(s(text), v))
+    return tr("time.%1: malformed number '%2'").arg(key, text);
+  SceneDocument after = doc_;
+  set_field(after.time, s(key), s(text.trimmed()));
+  commit(tr("Set time.%1").arg(key), std::move(after));
+  return {};
+}
+
+QString SceneController::set_solver(const QString& key, const QString& text) {
+  if (key == "method") {
+    static const QStringList methods = {"bdf", "adams", "rk4", "sdirk2"};
+    if (!text.isEmpty() && !methods.contains(text))
+      return tr("solver.method: unknown method '%1' (%2)").arg(text, methods.join(", "));
+  } else if (key == "sens_error_test") {
+    if (!text.isEmpty() && text != "true" && text != "false")
+      return tr("solver.sens_error_test: expected true or false");
+  } else {
+    double v = 0;
+    if (!text.isEmpty() && !engine::parse_number(s(text), v))
+      return tr("solver.%1: malformed number '%2'").arg(key, text);
+  }
+  SceneDocument after = doc_;
+  set_field(after.solver, s(key), s(text.trimmed()));
+  commit(tr("Set solver.%1").arg(key), std::move(after));
+  return {};
+}
+
+void SceneController::set_scene_info(const QString& name, const QString& description) {
+  SceneDocument after = doc_;
+  after.scene = s(name);
+  after.description = s(description);
+  commit(tr("Edit scene name"), std::move(after));
+}
+
+QString SceneController::add_scene_parameter(const QString& name, const QString& value) {
+  DocParameter p;
+  p.name = s(name);
+  p.value = s(value);
+  if (!valid_name(p.name)) return tr("parameter name '%1' must be non-empty, without '.' or spaces").arg(name);
+  if (doc_.find_parameter(p.name)) return tr("parameters.%1: defined twice").arg(name);
+  double v = 0;
+  if (!engine::parse_number(p.value, v)) return tr("parameters.%1: malformed number '%2'").arg(name, value);
+  SceneDocument after = doc_;
+  after.parameters.push_back(p);
+  commit(tr("Add parameter %1").arg(name), std::move(after));
+  return {};
+}
+
+QString SceneController::update_scene_parameter(const QString& name_q, const DocParameter& p) {
+  const std::string name = s(name_q);
+  const QString field = "parameters." + q(p.name);
+  if (!doc_.find_parameter(name)) return tr("no scene parameter '%1'").arg(name_q);
+  if (!valid_name(p.name)) return tr("parameter name '%1' must be non-empty, without '.' or spaces").arg(q(p.name));
+  if (p.name != name && doc_.find_parameter(p.name)) return tr("%1: defined twice").arg(field);
+  double v = 0, lo = -INFINITY, hi = INFINITY;
+  if (!engine::parse_number(p.value, v)) return tr("%1: malformed number '%2'").arg(field, q(p.value));
+  if (p.low.empty() != p.high.empty()) return tr("%1.range: give both ends or neither").arg(field);
+  if (!p.low.empty()) {
+    if (!engine::parse_number(p.low, lo) || !engine::parse_number(p.high, hi))
+      return tr("%1.range: malformed number").arg(field);
+    if (!(lo <= hi)) return tr("%1.range: low is above high").arg(field);
+    if (v < lo || v > hi) return tr("%1: value %2 outside its range").arg(field, q(p.value));
+  }
+  SceneDocument after = doc_;
+  *after.find_parameter(name) = p;
+  if (p.name != name) {
+    for (auto& b : after.blocks)
+      for (auto& [k, val] : b.values)
+        if (!val.is_list && val.text() == "$" + name) val = SceneValue::scalar("$" + p.name);
+    for (auto& sname : after.sensitivities)
+      if (sname == name) sname = p.name;
+  }
+  commit(tr("Edit parameter %1").arg(name_q), std::move(after));
+  return {};
+}
+
+QString SceneController::remove_scene_parameter(const QString& name_q) {
+  const std::string ref = "$" + s(name_q);
+  for (const auto& b : doc_.blocks)
+    for (const auto& [k, v] : b.values)
+      if (!v.is_list && v.text() == ref)
+        return tr("%1 drives %2.%3: change that first").arg(q(ref), q(b.name), q(k));
+  SceneDocument after = doc_;
+  std::erase_if(after.parameters, [&](const DocParameter& p) { return p.name == s(name_q); });
+  std::erase(after.sensitivities, s(name_q));
+  commit(tr("Delete parameter %1").arg(name_q), std::move(after));
+  return {};
+}
+
+void SceneController::set_sensitivity(const QString& name_q, bool on) {
+  const std::string name = s(name_q);
+  SceneDocument after = doc_;
+  const auto it = std::find(after.sensitivities.begin(), after.sensitivities.end(), name);
+  if (on && it == after.sensitivities.end()) after.sensitivities.push_back(name);
+  if (!on && it != after.sensitivities.end()) after.sensitivities.erase(it);
+  commit(on ? tr("Add direction d/d%1").arg(name_q) : tr("Remove direction d/d%1").arg(name_q),
+         std::move(after));
+}
+
+engine::Diagram SceneController::load_for_run() const {
+  if (!path_.isEmpty() && !modified() && QFileInfo::exists(path_)) return engine::load_scene(s(path_));
+  // Relative file settings (source.table) resolve against the scene's folder: write beside it.
+  const QString folder = path_.isEmpty() ? QDir::tempPath() : QFileInfo(path_).absolutePath();
+  QTemporaryFile file(folder + "/.dydp-gui-run-XXXXXX.yaml");
+  if (!file.open()) {
+    file.setFileTemplate(QDir::tempPath() + "/dydp-gui-run-XXXXXX.yaml");
+    if (!file.open()) throw engine::InputError("", 0, "", "cannot write a temporary scene file");
+  }
+  const std::string text = write_scene(doc_);
+  file.write(text.data(), static_cast<qint64>(text.size()));
+  file.close();
+  try {
+    return engine::load_scene(s(file.fileName()));
+  } catch (const engine::InputError& e) {
+    // Report against the document, not the temporary file; its lines are not the user's.
+    const std::string what = e.what();
+    const std::string prefix = e.field().empty() ? "" : e.field() + ": ";
+    const auto at = prefix.empty() ? what.find(": ") : what.find(prefix);
+    const std::string message =
+        at == std::string::npos ? what : what.substr(at + (prefix.empty() ? 2 : prefix.size()));
+    throw engine::InputError(path_.isEmpty() ? "unsaved scene" : s(path_), 0, e.field(), message);
+  }
+}
+
+QStringList SceneController::blocks_of_error(const engine::InputError& e) const {
+  QStringList out;
+  const std::string prefix = e.field().substr(0, e.field().find('.'));
+  if (doc_.find_block(prefix)) return {q(prefix)};
+  // An algebraic loop names its blocks in the message.
+  const QString what = QString::fromUtf8(e.what());
+  for (const auto& b : doc_.blocks) {
+    const QRegularExpression word("(^|[^\\w.])" + QRegularExpression::escape(q(b.name)) + "($|[^\\w])");
+    if (e.field() == "connections" && what.contains(word)) out << q(b.name);
+  }
+  return out;
+}
+
+}  // namespace dydp::gui

@@ -1,0 +1,102 @@
+// The GUI's model of a scene file: blocks (type, name, position, parameter values or $refs,
+// settings), connections, scene parameters, sensitivities, time, solver and outputs, kept as
+// the text the user wrote, so that a scene opened and saved again keeps its meaning exactly.
+// Reading and writing YAML live in scene_yaml.cpp; validation is the engine's (load_scene).
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace dydp::gui {
+
+/// A value as written in a scene: one scalar, or a list of scalars (`window: [2.0, 10.0]`).
+struct SceneValue {
+  std::vector<std::string> items;
+  bool is_list = false;
+
+  static SceneValue scalar(std::string text) { return {{std::move(text)}, false}; }
+  /// "[a, b]" reads as a list, anything else as one scalar (surrounding blanks removed).
+  static SceneValue parse(const std::string& text);
+  /// The inverse of parse: "1.5", "$mass", "[2.0, 10.0]".
+  std::string text() const;
+  bool operator==(const SceneValue&) const = default;
+};
+
+/// Keys with text values in the order they were written (time, solver).
+using Fields = std::vector<std::pair<std::string, std::string>>;
+const std::string* find_field(const Fields& f, const std::string& key);
+/// Sets key to text; an empty text removes the key.
+void set_field(Fields& f, const std::string& key, const std::string& text);
+
+struct DocBlock {
+  std::string name;
+  std::string type;
+  /// Parameters and settings of the block, in the order written (type excluded).
+  std::vector<std::pair<std::string, SceneValue>> values;
+  double x = 0.0, y = 0.0;  ///< canvas position of the block's top-left corner
+  bool placed = false;      ///< the position came from the `layout:` section or the canvas
+
+  const SceneValue* find(const std::string& key) const;
+  /// Sets key; an empty scalar removes the key (the type's default applies).
+  void set(const std::string& key, const SceneValue& v);
+  bool operator==(const DocBlock&) const = default;
+};
+
+struct DocParameter {
+  std::string name;
+  std::string value;
+  std::string unit;
+  std::string low, high;     ///< both empty: no range
+  std::string description;
+  bool operator==(const DocParameter&) const = default;
+};
+
+struct PortRef {
+  std::string block, port;
+  std::string text() const { return block + "." + port; }
+  /// "block.port"; false when there is no dot.
+  static bool parse(const std::string& text, PortRef& out);
+  bool operator==(const PortRef&) const = default;
+};
+
+struct DocConnection {
+  PortRef from, to;  ///< output port -> input port
+  std::string text() const { return from.text() + " -> " + to.text(); }
+  bool operator==(const DocConnection&) const = default;
+};
+
+struct SceneDocument {
+  std::string header_comment;  ///< leading `#` lines of the file, kept on save
+  std::string scene;
+  std::string description;
+  Fields time;
+  Fields solver;
+  std::vector<DocParameter> parameters;
+  std::vector<std::string> sensitivities;
+  std::vector<DocBlock> blocks;
+  std::vector<DocConnection> connections;
+  std::vector<std::string> outputs;
+
+  DocBlock* find_block(const std::string& name);
+  const DocBlock* find_block(const std::string& name) const;
+  DocParameter* find_parameter(const std::string& name);
+  const DocParameter* find_parameter(const std::string& name) const;
+  /// The connection driving input `to`, or null.
+  const DocConnection* driver_of(const PortRef& to) const;
+  /// A block name not yet used, from a stem ("sine" -> "sine", "sine2", ...).
+  std::string unique_block_name(const std::string& stem) const;
+  bool operator==(const SceneDocument&) const = default;
+};
+
+/// Reads a scene file. Throws engine::InputError (file, line) when the file is not YAML or not
+/// shaped like a scene (the engine checks everything else when the scene is run).
+SceneDocument read_scene_file(const std::string& path);
+/// Parses scene text; `file` names it in errors.
+SceneDocument parse_scene(const std::string& text, const std::string& file);
+/// The scene as YAML in the documented shape, with a `layout:` section of block positions.
+std::string write_scene(const SceneDocument& doc);
+/// Writes write_scene(doc) to path atomically.
+void write_scene_file(const SceneDocument& doc, const std::string& path);
+
+}  // namespace dydp::gui
