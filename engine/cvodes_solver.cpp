@@ -34,6 +34,8 @@ struct Problem {
   std::string cvodes_message;
   long sens_passes = 0;
   long jac_passes = 0;
+  /// Difference-quotient mode: the scene parameter values CVODES perturbs.
+  std::vector<double> scene_values;
 
   void refuse(double t, std::string why) {
     refusal = std::move(why);
@@ -53,6 +55,7 @@ void scatter(const std::vector<double>& in, int n, int count, N_Vector* v) {
 int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
   auto& P = *static_cast<Problem*>(user);
   double* xdot = NV_DATA_S(ydot);
+  if (!P.scene_values.empty()) P.ev.use_parameter_values(P.scene_values.data());
   if (P.nx == 0) xdot[0] = 0.0;
   try {
     P.ev.derivatives(t, NV_DATA_S(y), xdot);
@@ -110,6 +113,7 @@ int jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix J, void* user, N_Vec
 
 int quad_rhs(sunrealtype t, N_Vector y, N_Vector qdot, void* user) {
   auto& P = *static_cast<Problem*>(user);
+  if (!P.scene_values.empty()) P.ev.use_parameter_values(P.scene_values.data());
   try {
     P.ev.quadratures(t, NV_DATA_S(y), NV_DATA_S(qdot));
   } catch (const OutOfDomain& e) {
@@ -226,7 +230,16 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
     ev.initial_state_tangent(t0, NV_DATA_S(S.y), {dx0.data(), nx});
     for (int dir = 0; dir < ns; ++dir) N_VConst(0.0, S.ys[dir]);
     if (nx > 0) scatter(dx0, nx, ns, S.ys);
-    check(CVodeSensInit(S.mem, ns, CV_SIMULTANEOUS, sens_rhs, S.ys), "CVodeSensInit");
+    if (options.difference_quotient_sensitivities) {
+      for (const auto& p : d.parameters) P.scene_values.push_back(p.value);
+      std::vector<int> plist(d.sensitivities.begin(), d.sensitivities.end());
+      std::vector<double> pbar;
+      for (int i : d.sensitivities) pbar.push_back(std::fabs(d.parameters[i].value) > 0 ? std::fabs(d.parameters[i].value) : 1.0);
+      check(CVodeSensInit(S.mem, ns, CV_SIMULTANEOUS, nullptr, S.ys), "CVodeSensInit");
+      check(CVodeSetSensParams(S.mem, P.scene_values.data(), pbar.data(), plist.data()), "CVodeSetSensParams");
+    } else {
+      check(CVodeSensInit(S.mem, ns, CV_SIMULTANEOUS, sens_rhs, S.ys), "CVodeSensInit");
+    }
     check(CVodeSensSStolerances(S.mem, d.solver.rtol, atol_s.data()), "CVodeSensSStolerances");
     check(CVodeSetSensErrCon(S.mem, d.solver.sens_error_test), "CVodeSetSensErrCon");
     if (!bdf) {
@@ -243,7 +256,10 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
     if (ns > 0) {
       S.yqs = N_VCloneVectorArray(ns, S.yq);
       for (int dir = 0; dir < ns; ++dir) N_VConst(0.0, S.yqs[dir]);
-      check(CVodeQuadSensInit(S.mem, quad_sens_rhs, S.yqs), "CVodeQuadSensInit");
+      // Quadrature sensitivities always come from the exact integrand tangents (also in
+      // difference-quotient mode: CVODES 6.4's internal quadrature quotients crashed here).
+      check(CVodeQuadSensInit(S.mem, quad_sens_rhs, S.yqs),
+            "CVodeQuadSensInit");
       check(CVodeQuadSensSStolerances(S.mem, d.solver.rtol, atol_s.data()),
             "CVodeQuadSensSStolerances");
       check(CVodeSetQuadSensErrCon(S.mem, d.solver.sens_error_test), "CVodeSetQuadSensErrCon");

@@ -34,8 +34,23 @@ Eval Evaluator::eval_for(const Node& n, int index, double t, const double* x) co
   e.segment_start = segment_start_;
   e.x = x ? x + n.state_offset : nullptr;
   e.u = u_.data() + u_offset_[index];
-  e.p = n.p.data();
+  e.p = p_override_.empty() ? n.p.data() : p_override_[index].data();
   return e;
+}
+
+void Evaluator::use_parameter_values(const double* scene_values) {
+  if (p_override_.empty())
+    for (const Node& n : d_.nodes) p_override_.push_back(n.p);
+  bool changed = false;
+  for (size_t i = 0; i < d_.nodes.size(); ++i) {
+    const Node& n = d_.nodes[i];
+    for (size_t j = 0; j < n.p.size(); ++j)
+      if (n.p_scene[j] >= 0 && p_override_[i][j] != scene_values[n.p_scene[j]]) {
+        p_override_[i][j] = scene_values[n.p_scene[j]];
+        changed = true;
+      }
+  }
+  if (changed) valid_ = false;
 }
 
 Seeds Evaluator::seeds_for(const Node& n, int index, int nd, ConstDirView dx, bool with_params) {

@@ -17,6 +17,10 @@ class Evaluator {
   Evaluator(const Diagram& d, bool with_sensitivities);
 
   int num_directions() const { return ns_; }
+
+  /// Evaluates with these scene parameter values (indexed like Diagram::parameters) instead
+  /// of the diagram's, for CVODES' difference-quotient sensitivities, which perturb them.
+  void use_parameter_values(const double* scene_values);
   void set_segment_start(double t) { segment_start_ = t; valid_ = false; }
 
   /// x(t0) and, for the sensitivity directions, dx(t0)/dp (ld = num_states).
@@ -57,6 +61,7 @@ class Evaluator {
   std::vector<double> pseed_;          ///< per node np x ns, d-major, concatenated
   std::vector<int> pseed_offset_;
   std::vector<bool> driven_;           ///< node has a parameter driven by a direction
+  std::vector<std::vector<double>> p_override_;  ///< per node, when use_parameter_values was called
   std::vector<const double*> u_;       ///< input pointers, per node concatenated
   std::vector<int> u_offset_;
   std::vector<double*> y_;             ///< output pointers, per node concatenated

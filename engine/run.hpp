@@ -14,6 +14,9 @@ struct RunResult;
 
 struct RunOptions {
   bool sensitivities = true;                  ///< false: --no-sens, no tangent work at all
+  /// CVODES only: true replaces the diagram's tangent pass by CVODES' own difference-quotient
+  /// sensitivity right-hand side (for comparison; the default is the exact tangent pass).
+  bool difference_quotient_sensitivities = false;
   std::function<void(double t)> progress;     ///< called at every output time
   /// Called at every output time with the result so far (its last sample is the new one):
   /// for streaming outputs. An exception thrown here ends the run.

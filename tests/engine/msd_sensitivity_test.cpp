@@ -184,3 +184,21 @@ TEST_P(FixedStep, DiffersFromTheOdeSensitivityByTheDiscretisationError) {
 
 }  // namespace
 }  // namespace dydp::engine
+
+namespace dydp::engine {
+namespace {
+
+// CVODES' own difference-quotient sensitivities (for comparison in benchmarks) approximate
+// the exact ones from the tangent pass.
+TEST(DifferenceQuotient, ApproximatesTheExactSensitivities) {
+  const Diagram d = load("{method: bdf, rtol: 1.0e-8, atol: 1.0e-10}");
+  RunOptions dq;
+  dq.difference_quotient_sensitivities = true;
+  const RunResult exact = run(d), approx = run(d, dq);
+  for (int j = 0; j < 3; ++j)
+    EXPECT_NEAR(approx.objectives[0].sensitivity[j], exact.objectives[0].sensitivity[j],
+                1e-4 * std::fabs(exact.objectives[0].sensitivity[j]));
+}
+
+}  // namespace
+}  // namespace dydp::engine
