@@ -35,6 +35,16 @@ int main(int argc, char** argv) {
   const QString shot = cli.value(shot_option);
   auto take_shot = [&] {
     QTimer::singleShot(300, &window, [&] {
+      // Show the property editor filled: select the block with the most parameters.
+      const auto& blocks = window.controller()->document().blocks;
+      size_t most = 0;
+      QString richest;
+      for (const auto& b : blocks)
+        if (const auto* type = dydp::engine::Registry::global().find(b.type); type && type->parameters.size() > most) {
+          most = type->parameters.size();
+          richest = QString::fromStdString(b.name);
+        }
+      if (!richest.isEmpty()) window.canvas()->select_block(richest);
       window.canvas()->fit_all();
       QApplication::processEvents();
       const bool ok = window.grab().save(shot);

@@ -23,6 +23,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   auto* palette_dock = new QDockWidget(tr("Blocks"));
   palette_dock->setObjectName("palette");
   palette_dock->setWidget(palette_);
+  palette_->setMinimumWidth(270);
   addDockWidget(Qt::LeftDockWidgetArea, palette_dock);
 
   properties_ = new PropertyEditor(&controller_);
