@@ -1,6 +1,7 @@
 // Scenes built in the GUI by the calls a drag makes (palette drop, port-to-port wire, property
 // edits), saved, reopened and run in the worker thread; refusals with reasons; undo and redo;
 // validation errors marked on their block; cancelling a run.
+#include <QMimeData>
 #include <QSignalSpy>
 #include <QTemporaryDir>
 #include <QtTest>
@@ -220,6 +221,65 @@ class GuiEditing : public QObject {
     QVERIFY(w.canvas()->block_item("sum")->has_error());
     QVERIFY(w.canvas()->block_item("gain")->has_error());
     QVERIFY(!w.canvas()->block_item("constant")->has_error());
+  }
+
+  void mouse_drags_wire_ports_and_move_blocks() {
+    MainWindow w;
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    Canvas* canvas = w.canvas();
+    SceneController* c = w.controller();
+    canvas->drop_block("source.constant", {0, 0});
+    canvas->drop_block("math.gain", {260, 0});
+    canvas->resetTransform();
+    canvas->centerOn(200, 40);
+    QWidget* vp = canvas->viewport();
+    auto at = [&](PortItem* p) { return canvas->mapFromScene(p->anchor()); };
+    // Output to output: refused, nothing wired.
+    PortItem* y = canvas->block_item("constant")->port("y", false);
+    PortItem* gy = canvas->block_item("gain")->port("y", false);
+    QTest::mousePress(vp, Qt::LeftButton, {}, at(y));
+    QTest::mouseMove(vp, at(gy));
+    QTest::mouseRelease(vp, Qt::LeftButton, {}, at(gy));
+    QCOMPARE(canvas->wire_count(), 0);
+    // Output to input: wired.
+    PortItem* u = canvas->block_item("gain")->port("u", true);
+    QTest::mousePress(vp, Qt::LeftButton, {}, at(y));
+    QTest::mouseMove(vp, at(u));
+    QTest::mouseRelease(vp, Qt::LeftButton, {}, at(u));
+    QCOMPARE(canvas->wire_count(), 1);
+    QCOMPARE(QString::fromStdString(c->document().connections.front().text()), QString("constant.y -> gain.u"));
+    // Dragging a block by its header moves it, as one undo step.
+    const int steps = c->undo_stack()->count();
+    const QPoint header = canvas->mapFromScene(QPointF(330, 10));
+    QTest::mousePress(vp, Qt::LeftButton, {}, header);
+    QTest::mouseMove(vp, header + QPoint(20, 30));
+    QTest::mouseMove(vp, header + QPoint(40, 60));
+    QTest::mouseRelease(vp, Qt::LeftButton, {}, header + QPoint(40, 60));
+    const DocBlock* gain = c->document().find_block("gain");
+    QVERIFY2(gain->x > 260.0 && gain->y > 0.0, QString("%1, %2").arg(gain->x).arg(gain->y).toUtf8().constData());
+    QCOMPARE(c->undo_stack()->count(), steps + 1);
+    c->undo_stack()->undo();
+    QCOMPARE(c->document().find_block("gain")->x, 260.0);
+
+    // A palette entry dropped on the canvas: the mime data the palette makes, delivered as a drop.
+    QTreeWidgetItem* sine = nullptr;
+    for (int i = 0; i < w.palette()->topLevelItemCount() && !sine; ++i)
+      for (int k = 0; k < w.palette()->topLevelItem(i)->childCount(); ++k)
+        if (w.palette()->topLevelItem(i)->child(k)->text(0) == "source.sine") sine = w.palette()->topLevelItem(i)->child(k);
+    QVERIFY(sine);
+    std::unique_ptr<QMimeData> mime(w.palette()->model()->mimeData({w.palette()->indexFromItem(sine)}));
+    QVERIFY(mime && mime->hasFormat(kBlockTypeMime));
+    const QPoint drop = canvas->mapFromScene(QPointF(100, 200));
+    QDragEnterEvent enter(drop, Qt::CopyAction, mime.get(), Qt::LeftButton, {});
+    QApplication::sendEvent(vp, &enter);
+    QVERIFY(enter.isAccepted());
+    QDropEvent dropped(QPointF(drop), Qt::CopyAction, mime.get(), Qt::LeftButton, {});
+    QApplication::sendEvent(vp, &dropped);
+    const DocBlock* added = c->document().find_block("sine");
+    QVERIFY(added);
+    QVERIFY(std::abs(added->x - 100) <= 1 && std::abs(added->y - 200) <= 1);
+    QCOMPARE(canvas->selected_blocks(), QStringList{"sine"});
   }
 
   void a_run_can_be_cancelled_and_run_again() {
