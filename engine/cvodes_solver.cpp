@@ -16,7 +16,7 @@
 
 #include "engine/cpu_clock.hpp"
 #include "engine/errors.hpp"
-#include "engine/output_grid.hpp"
+#include "engine/timeline.hpp"
 #include "engine/recorder.hpp"
 
 namespace dydp::engine {
@@ -292,16 +292,12 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   };
   record(t0);
 
-  const std::vector<double> outputs = output_grid(d.time);
-  const std::vector<double> breaks = d.breakpoints(t0, tf);
-  std::vector<double> events(outputs.begin() + 1, outputs.end());
-  events.insert(events.end(), breaks.begin(), breaks.end());
-  std::sort(events.begin(), events.end());
-  events.erase(std::unique(events.begin(), events.end()), events.end());
+  const Timeline timeline(d);
+  const std::vector<double>& breaks = timeline.breaks;
 
   double t = t0;
-  size_t next_break = 0, next_output = 1;
-  for (double target : events) {
+  size_t next_break = 0;
+  for (double target : timeline.events) {
     while (next_break < breaks.size() && breaks[next_break] < target) ++next_break;
     const double stop = next_break < breaks.size() ? breaks[next_break] : tf;
     check(CVodeSetStopTime(S.mem, stop), "CVodeSetStopTime");
@@ -317,10 +313,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
       throw SolverError(t, block, reason);
     }
     t = target;
-    if (next_output < outputs.size() && outputs[next_output] == target) {
-      record(target);
-      ++next_output;
-    }
+    if (timeline.is_output(target)) record(target);
     if (next_break < breaks.size() && breaks[next_break] == target && target < tf) {
       accumulate();
       ev.set_segment_start(target);
@@ -353,12 +346,9 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   recorder.finish(q.data(), {dq.data(), std::max(nq, 1)});
   result.final_state.assign(NV_DATA_S(S.y), NV_DATA_S(S.y) + nx);
 
-  st.method = d.solver.method;
   st.rtol = d.solver.rtol;
   st.atol = d.solver.atol;
-  st.cpu_seconds = clock.seconds();
-  st.simulated_seconds = tf - t0;
-  st.realtime_factor = st.cpu_seconds > 0 ? st.simulated_seconds / st.cpu_seconds : 0.0;
+  finish_stats(st, d.solver.method, clock.seconds(), d.time);
   return result;
 }
 

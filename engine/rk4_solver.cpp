@@ -5,7 +5,7 @@
 
 #include "engine/cpu_clock.hpp"
 #include "engine/errors.hpp"
-#include "engine/output_grid.hpp"
+#include "engine/timeline.hpp"
 #include "engine/recorder.hpp"
 
 namespace dydp::engine {
@@ -21,7 +21,7 @@ struct Rk4State {
 RunResult run_rk4(const Diagram& d, const RunOptions& options) {
   const int nx = d.num_states, nq = d.num_quadratures;
   const int ns = options.sensitivities ? static_cast<int>(d.sensitivities.size()) : 0;
-  const double t0 = d.time.start, tf = d.time.stop;
+  const double t0 = d.time.start;
   const double h_max = d.solver.step > 0 ? d.solver.step : d.time.output_step / 10.0;
 
   Evaluator ev(d, ns > 0);
@@ -79,17 +79,11 @@ RunResult run_rk4(const Diagram& d, const RunOptions& options) {
   };
   record(t0);
 
-  const std::vector<double> outputs = output_grid(d.time);
-  const std::vector<double> breaks = d.breakpoints(t0, tf);
-  std::vector<double> events(outputs.begin() + 1, outputs.end());
-  events.insert(events.end(), breaks.begin(), breaks.end());
-  std::sort(events.begin(), events.end());
-  events.erase(std::unique(events.begin(), events.end()), events.end());
+  const Timeline timeline(d);
 
   double t = t0;
-  size_t next_output = 1;
-  for (double target : events) {
-    const long n = std::max(1L, std::lround(std::ceil((target - t) / h_max - 1e-9)));
+  for (double target : timeline.events) {
+    const long n = fixed_steps(t, target, h_max);
     const double h = (target - t) / n;
     for (long step = 0; step < n; ++step) {
       const double tn = t + step * h;
@@ -114,20 +108,14 @@ RunResult run_rk4(const Diagram& d, const RunOptions& options) {
       ++st.steps;
     }
     t = target;
-    if (next_output < outputs.size() && outputs[next_output] == target) {
-      record(target);
-      ++next_output;
-    }
-    if (std::binary_search(breaks.begin(), breaks.end(), target)) ev.set_segment_start(target);
+    if (timeline.is_output(target)) record(target);
+    if (timeline.is_break(target)) ev.set_segment_start(target);
   }
   recorder.finish(s.q.data(), {s.dq.data(), std::max(nq, 1)});
   result.final_state.assign(s.x.begin(), s.x.begin() + nx);
 
-  st.method = "rk4";
   st.step = h_max;
-  st.cpu_seconds = clock.seconds();
-  st.simulated_seconds = tf - t0;
-  st.realtime_factor = st.cpu_seconds > 0 ? st.simulated_seconds / st.cpu_seconds : 0.0;
+  finish_stats(st, "rk4", clock.seconds(), d.time);
   return result;
 }
 

@@ -6,7 +6,7 @@
 
 #include "engine/cpu_clock.hpp"
 #include "engine/errors.hpp"
-#include "engine/output_grid.hpp"
+#include "engine/timeline.hpp"
 #include "engine/recorder.hpp"
 
 namespace dydp::engine {
@@ -122,7 +122,7 @@ class Stepper {
 RunResult run_sdirk(const Diagram& d, const RunOptions& options) {
   const int nx = d.num_states, nq = d.num_quadratures;
   const int ns = options.sensitivities ? static_cast<int>(d.sensitivities.size()) : 0;
-  const double t0 = d.time.start, tf = d.time.stop;
+  const double t0 = d.time.start;
   const double h_max = d.solver.step > 0 ? d.solver.step : d.time.output_step / 10.0;
 
   Evaluator ev(d, ns > 0);
@@ -147,18 +147,12 @@ RunResult run_sdirk(const Diagram& d, const RunOptions& options) {
   };
   record(t0);
 
-  const std::vector<double> outputs = output_grid(d.time);
-  const std::vector<double> breaks = d.breakpoints(t0, tf);
-  std::vector<double> events(outputs.begin() + 1, outputs.end());
-  events.insert(events.end(), breaks.begin(), breaks.end());
-  std::sort(events.begin(), events.end());
-  events.erase(std::unique(events.begin(), events.end()), events.end());
+  const Timeline timeline(d);
 
   double t = t0;
-  size_t next_output = 1;
   if (nx > 0) stepper.jacobian(t0, x);
-  for (double target : events) {
-    const long n = std::max(1L, std::lround(std::ceil((target - t) / h_max - 1e-9)));
+  for (double target : timeline.events) {
+    const long n = fixed_steps(t, target, h_max);
     const double h = (target - t) / n, hg = kGamma * h;
     for (long step = 0; step < n; ++step) {
       const double tn = t + step * h, t1 = tn + hg, t2 = tn + h;
@@ -182,22 +176,16 @@ RunResult run_sdirk(const Diagram& d, const RunOptions& options) {
       ++st.steps;
     }
     t = target;
-    if (next_output < outputs.size() && outputs[next_output] == target) {
-      record(target);
-      ++next_output;
-    }
-    if (std::binary_search(breaks.begin(), breaks.end(), target)) ev.set_segment_start(target);
+    if (timeline.is_output(target)) record(target);
+    if (timeline.is_break(target)) ev.set_segment_start(target);
   }
   Vector qf = Vector::Zero(std::max(nq, 1));
   qf.head(nq) = q;
   recorder.finish(qf.data(), {Sq.data(), static_cast<int>(Sq.rows())});
   result.final_state.assign(x.data(), x.data() + nx);
 
-  st.method = "sdirk2";
   st.step = h_max;
-  st.cpu_seconds = clock.seconds();
-  st.simulated_seconds = tf - t0;
-  st.realtime_factor = st.cpu_seconds > 0 ? st.simulated_seconds / st.cpu_seconds : 0.0;
+  finish_stats(st, "sdirk2", clock.seconds(), d.time);
   return result;
 }
 
