@@ -156,6 +156,16 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += string_array("parameter_names", parameters);
   d += number_array("double", "parameter_values", parameter_values);
   d += string_array("sensor_names", model.sensor_output_names());
+  std::vector<std::string> sensor_ports;
+  std::vector<int> sensor_widths, sensor_acc;
+  for (const auto& sensor : model.sensors) {
+    sensor_ports.push_back(sensor.name);
+    sensor_widths.push_back(sensor.width());
+    sensor_acc.push_back(sensor.type == mbs::Sensor::Type::Acceleration || sensor.type == mbs::Sensor::Type::Joint);
+  }
+  d += string_array("sensor_ports", sensor_ports);
+  d += number_array("int", "sensor_widths", sensor_widths);
+  d += number_array("int", "sensor_reads_acceleration", sensor_acc);
   d += number_array("double", "initial_q", q0);
   d += number_array("int", "driven", driven);
   d += number_array("int", "independent", independent);
@@ -166,7 +176,8 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += "    \"" + name + "\", " + std::to_string(model.coordinates()) + ", " + std::to_string(model.constraint_count()) +
        ", " + std::to_string(model.input_count()) + ", " + std::to_string(model.loads.size()) + ", " +
        std::to_string(parameters.size()) + ", " + std::to_string(model.sensor_output_names().size()) + ",\n";
-  d += "    coordinate_names, input_names, parameter_names, parameter_values, sensor_names, initial_q,\n";
+  d += "    coordinate_names, input_names, parameter_names, parameter_values, sensor_names,\n";
+  d += "    " + std::to_string(sensor_ports.size()) + ", sensor_ports, sensor_widths, sensor_reads_acceleration, initial_q,\n";
   d += "    " + std::to_string(driven.size()) + ", driven, " + std::to_string(independent.size()) + ", independent,\n";
   d += "    " + name + "_mass, " + name + "_residual, " + name + "_residual_tangent, " + name + "_constraints,\n";
   d += "    " + name + "_velocity_constraints_tangent, " + name + "_sensors, " + name + "_sensors_tangent};\n\n";

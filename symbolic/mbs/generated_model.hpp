@@ -32,7 +32,11 @@ struct GeneratedModel {
   const char* const* input_names;
   const char* const* parameter_names;
   const double* parameter_values;  // as written in the model
-  const char* const* sensor_names;
+  const char* const* sensor_names;  // one per sensor output (`tip.x`)
+  int sensor_count;                 // sensors (each sensor_widths[i] outputs, in order)
+  const char* const* sensor_ports;  // sensor names
+  const int* sensor_widths;
+  const int* sensor_reads_acceleration;  // 1: depends on qdd (acceleration and joint sensors)
   const double* initial_q;
   int driven_count;
   const int* driven;       // coordinates imposed by inputs

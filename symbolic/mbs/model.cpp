@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 
@@ -153,6 +154,12 @@ class Loader {
     m_.bodies.push_back(ground);
 
     const YAML::Node bodies = root["bodies"];
+    struct PendingParent {
+      int first_joint;
+      YAML::Node node;
+      std::string field;
+    };
+    std::vector<PendingParent> parents;
     if (!bodies || !bodies.IsSequence() || bodies.size() == 0) fail(root, "bodies", "expected a non-empty list");
     for (std::size_t bi = 0; bi < bodies.size(); ++bi) {
       const YAML::Node b = bodies[bi];
@@ -164,12 +171,13 @@ class Loader {
       field = "bodies." + body.name;
       for (const Body& other : m_.bodies)
         if (other.name == body.name) fail(b["name"], field, "duplicate body name");
-      const int parent_body = b["parent"] ? body_index(b["parent"], text(b["parent"], field + ".parent"), field + ".parent") : 0;
+      // parents may be declared later: resolved once every body is known
+      if (b["parent"]) parents.push_back({static_cast<int>(m_.joints.size()), b["parent"], field + ".parent"});
       Vec3Value offset{};
       if (b["offset"]) offset = vec3(b["offset"], field + ".offset");
       const YAML::Node js = b["joints"];
       if (!js || !js.IsSequence() || js.size() == 0) fail(b, field + ".joints", "expected a non-empty list of joints");
-      int parent_joint = m_.bodies[parent_body].frame;
+      int parent_joint = -1;
       for (std::size_t k = 0; k < js.size(); ++k) {
         const YAML::Node j = js[k];
         const std::string jf = field + ".joints[" + std::to_string(k) + "]";
@@ -204,6 +212,20 @@ class Loader {
       anchors(b["anchors"], body, field + ".anchors");
       m_.bodies.push_back(body);
     }
+
+    for (const auto& [first_joint, node, field] : parents)
+      m_.joints[first_joint].parent = m_.bodies[body_index(node, text(node, field), field)].frame;
+    // Joints in an order where parents come first (coordinates keep the declaration order).
+    std::vector<int> state(m_.joints.size(), 0);  // 0 new, 1 visiting, 2 done
+    std::function<void(int)> visit = [&](int j) {
+      if (state[j] == 2) return;
+      if (state[j] == 1) fail(bodies, "bodies", "the parents form a loop (close loops with cuts)");
+      state[j] = 1;
+      if (m_.joints[j].parent >= 0) visit(m_.joints[j].parent);
+      state[j] = 2;
+      m_.order.push_back(j);
+    };
+    for (std::size_t j = 0; j < m_.joints.size(); ++j) visit(static_cast<int>(j));
 
     if (const YAML::Node cs = root["cuts"]) {
       for (std::size_t i = 0; i < cs.size(); ++i) {

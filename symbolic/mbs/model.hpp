@@ -119,6 +119,7 @@ struct Model {
   std::vector<Sensor> sensors;
   std::vector<JacobianRequest> jacobians;
   std::vector<int> independent;  // chosen by the model; empty: automatic (pivoted QR)
+  std::vector<int> order;        // joints with every parent before its children
 
   int coordinates() const { return static_cast<int>(joints.size()); }
   int constraint_count() const;

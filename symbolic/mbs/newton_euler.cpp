@@ -230,7 +230,7 @@ class Generator {
       cos_.push_back(symbolic::cos(ctx_->element(out_.q, k)));
       sin_.push_back(symbolic::sin(ctx_->element(out_.q, k)));
     }
-    for (int k = 0; k < n; ++k) {
+    for (const int k : m_.order) {
       const Joint& j = m_.joints[k];
       const Rot parent = j.parent >= 0 ? rot_[j.parent] : Rot{{unit(0), unit(1), unit(2)}};
       const V3 parent_origin = j.parent >= 0 ? origin_[j.parent] : zero3();
@@ -252,7 +252,7 @@ class Generator {
     const int n = m_.coordinates();
     omega_.resize(n);
     velocity_.resize(n);
-    for (int k = 0; k < n; ++k) {
+    for (const int k : m_.order) {
       const Joint& j = m_.joints[k];
       const V3 wp = j.parent >= 0 ? omega_[j.parent] : zero3();
       const V3 vp = j.parent >= 0 ? velocity_[j.parent] : zero3();
@@ -287,7 +287,7 @@ class Generator {
   std::vector<Expr> dynamics(const std::vector<Expr>& qdd, bool full, const std::string& tag) {
     const int n = m_.coordinates();
     std::vector<V3> omega(n), alpha(n), acc(n);
-    for (int k = 0; k < n; ++k) {
+    for (const int k : m_.order) {
       const Joint& j = m_.joints[k];
       const V3 wp = j.parent >= 0 ? omega[j.parent] : zero3();
       const V3 ap = j.parent >= 0 ? alpha[j.parent] : zero3();
@@ -367,7 +367,8 @@ class Generator {
 
     std::vector<V3> child_f(n, zero3()), child_n(n, zero3());
     std::vector<Expr> q_force(n);
-    for (int k = n - 1; k >= 0; --k) {
+    for (auto it = m_.order.rbegin(); it != m_.order.rend(); ++it) {
+      const int k = *it;
       const Joint& j = m_.joints[k];
       V3 f = child_f[k], t = child_n[k];
       if (j.body >= 0) {

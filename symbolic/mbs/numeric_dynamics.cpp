@@ -44,7 +44,7 @@ NumericDynamics::Kinematics NumericDynamics::kinematics(const Vector& q, const V
   k.velocity.resize(n);
   k.alpha.resize(n);
   k.acceleration.resize(n);
-  for (int j = 0; j < n; ++j) {
+  for (const int j : model_.order) {
     const Joint& joint = model_.joints[j];
     M3 Rp = M3::Identity();
     V3 xp = V3::Zero(), wp = V3::Zero(), vp = V3::Zero(), ap = V3::Zero(), acc_p = V3::Zero();
@@ -158,7 +158,8 @@ NumericDynamics::Vector NumericDynamics::residual(const Vector& q, const Vector&
 
   // Backward pass: wrench each joint transmits to its subtree, about the joint frame origin.
   std::vector<V3> f(n, V3::Zero()), t(n, V3::Zero());
-  for (int j = n - 1; j >= 0; --j) {
+  for (auto it = model_.order.rbegin(); it != model_.order.rend(); ++it) {
+    const int j = *it;
     const Joint& joint = model_.joints[j];
     if (joint.body >= 0) {
       const Body& b = model_.bodies[joint.body];

@@ -1,0 +1,263 @@
+// multibody: a generated multibody model (generated_models/) as a block. States: the independent
+// coordinates u and velocities u_dot; dependent coordinates are solved by Newton-Raphson on the
+// generated constraints at every evaluation. Inputs: one port per load of the model (force or
+// torque, width 3, in the load's declared frame) and per driven joint (q, qd, qdd). Outputs:
+// q, qd, qdd (all coordinates, model order) and one port per sensor. Tangents go through the
+// generated tangent functions and the partitioning's tangent (ReducedDynamics::tangent).
+//
+// Types: `multibody` with setting `model: NAME` (the model's parameter values and initial
+// configuration), and `multibody.NAME` per model, whose block parameters are the model's
+// symbolic parameters and the initial values `q0.<u>`, `qd0.<u>` of its independent coordinates
+// (so scenes can make them sensitivity directions).
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+
+#include "engine/registry.hpp"
+#include "generated_models/registry.hpp"
+#include "symbolic/mbs/reduced_dynamics.hpp"
+
+namespace dydp::blocks {
+namespace {
+
+using engine::Block;
+using engine::DirView;
+using engine::Eval;
+using engine::Seeds;
+using mbs::GeneratedModel;
+using mbs::ReducedDynamics;
+using Vector = Eigen::VectorXd;
+using Matrix = Eigen::MatrixXd;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+class Multibody : public Block {
+ public:
+  // `exposed`: block parameters are [model parameters, q0 of u, qd0 of u]; otherwise none.
+  Multibody(const GeneratedModel& model, bool exposed)
+      : g_(model), reduced_(model), exposed_(exposed), last_q_(Eigen::Map<const Vector>(model.initial_q, model.n)) {
+    for (int i = 0; i < g_.loads; ++i) {
+      std::string name = g_.input_names[3 * i];
+      declare_input(name.substr(0, name.rfind('.')), 3, "N or N m");
+    }
+    for (int i = 0; i < g_.driven_count; ++i) declare_input(g_.coordinate_names[g_.driven[i]], 3, "q, qd, qdd");
+    const bool driven = g_.driven_count > 0;
+    declare_output("q", g_.n, "m or rad", driven);
+    declare_output("qd", g_.n, "m/s or rad/s", driven);
+    declare_output("qdd", g_.n, "m/s^2 or rad/s^2", true);
+    for (int s = 0; s < g_.sensor_count; ++s)
+      declare_output(g_.sensor_ports[s], g_.sensor_widths[s], "", driven || g_.sensor_reads_acceleration[s]);
+    std::vector<std::string> states;
+    for (int j : reduced_.independent()) states.push_back(std::string("q.") + g_.coordinate_names[j]);
+    for (int j : reduced_.independent()) states.push_back(std::string("qd.") + g_.coordinate_names[j]);
+    declare_states(states);
+  }
+
+  void initial_state(const Eval& e, double* x0) const override {
+    {
+      // a new run: Newton-Raphson starts again from the model's assembly configuration, so the
+      // mechanism is assembled in the same branch every run
+      std::lock_guard<std::mutex> lock(mutex_);
+      last_q_ = Eigen::Map<const Vector>(g_.initial_q, g_.n);
+      have_ = false;
+    }
+    const int nu = reduced_.nu();
+    for (int i = 0; i < nu; ++i) {
+      x0[i] = exposed_ ? e.p[g_.parameters + i] : g_.initial_q[reduced_.independent()[i]];
+      x0[nu + i] = exposed_ ? e.p[g_.parameters + nu + i] : 0.0;
+    }
+  }
+  void initial_state_tangent(const Eval&, const Seeds& s, DirView dx0) const override {
+    const int nu = reduced_.nu();
+    for (int d = 0; d < s.directions; ++d)
+      for (int i = 0; i < 2 * nu; ++i) dx0(i, d) = exposed_ ? s.p(g_.parameters + i, d) : 0.0;
+  }
+
+  void outputs(const Eval& e, double* const* y) const override {
+    const ReducedDynamics::Result& r = solve(e);
+    const int n = g_.n;
+    std::copy_n(r.q.data(), n, y[0]);
+    std::copy_n(r.qd.data(), n, y[1]);
+    if (e.inputs_ready) std::copy_n(r.qdd.data(), n, y[2]);
+    if (g_.sensor_count == 0) return;
+    std::vector<double> out(std::max(1, g_.sensor_outputs));
+    const Vector lam = padded(r.lam);
+    const Vector inp = inputs(e);
+    g_.sensors(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), inp.data(), parameters(e), out.data());
+    int at = 0;
+    for (int s = 0; s < g_.sensor_count; ++s) {
+      if (e.inputs_ready || !Block::outputs()[3 + s].feedthrough) std::copy_n(out.data() + at, g_.sensor_widths[s], y[3 + s]);
+      at += g_.sensor_widths[s];
+    }
+  }
+
+  void outputs_tangent(const Eval& e, const Seeds& s, const DirView* dy) const override {
+    const ReducedDynamics::Result& r = solve(e);
+    Matrix dq, dqd, dqdd, dinp, dp;
+    tangent(e, s, r, dq, dqd, dqdd, dinp, dp);
+    const int n = g_.n, nd = s.directions;
+    for (int d = 0; d < nd; ++d)
+      for (int i = 0; i < n; ++i) {
+        dy[0](i, d) = dq(i, d);
+        dy[1](i, d) = dqd(i, d);
+        if (e.inputs_ready) dy[2](i, d) = dqdd(i, d);
+      }
+    if (g_.sensor_count == 0 || nd == 0) return;
+    const int ns = g_.sensor_outputs;
+    std::vector<double> out(std::max(1, ns)), dout(static_cast<std::size_t>(std::max(1, ns)) * nd);
+    const Vector lam = padded(r.lam);
+    const Vector inp = inputs(e);
+    g_.sensors_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), inp.data(), parameters(e), nd, dq.data(),
+                       dqd.data(), dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
+    int at = 0;
+    for (int k = 0; k < g_.sensor_count; ++k) {
+      if (e.inputs_ready || !Block::outputs()[3 + k].feedthrough)
+        for (int d = 0; d < nd; ++d)
+          for (int i = 0; i < g_.sensor_widths[k]; ++i) dy[3 + k](i, d) = dout[d * ns + at + i];
+      at += g_.sensor_widths[k];
+    }
+  }
+
+  void derivatives(const Eval& e, double* xdot) const override {
+    const ReducedDynamics::Result& r = solve(e);
+    const int nu = reduced_.nu();
+    for (int i = 0; i < nu; ++i) {
+      xdot[i] = e.x[nu + i];
+      xdot[nu + i] = r.udd[i];
+    }
+  }
+
+  void derivatives_tangent(const Eval& e, const Seeds& s, DirView dxdot) const override {
+    const ReducedDynamics::Result& r = solve(e);
+    Matrix dq, dqd, dqdd, dinp, dp;
+    tangent(e, s, r, dq, dqd, dqdd, dinp, dp);
+    const int nu = reduced_.nu();
+    for (int d = 0; d < s.directions; ++d)
+      for (int i = 0; i < nu; ++i) {
+        dxdot(i, d) = s.x(nu + i, d);
+        dxdot(nu + i, d) = dqdd(reduced_.independent()[i], d);
+      }
+  }
+
+ private:
+  Vector padded(const Vector& v) const { return v.size() ? v : Vector::Zero(1); }
+
+  const double* parameters(const Eval& e) const {
+    return exposed_ && g_.parameters ? e.p : (g_.parameters ? g_.parameter_values : zero_);
+  }
+
+  Vector inputs(const Eval& e) const {
+    Vector in = Vector::Zero(std::max(1, g_.inputs));
+    if (!e.inputs_ready) {
+      // driven motions are needed by every output when the model has any (then all feed through)
+      return in;
+    }
+    const int ports = g_.loads + g_.driven_count;
+    for (int k = 0; k < ports; ++k)
+      for (int i = 0; i < 3; ++i) in[3 * k + i] = e.u[k][i];
+    return in;
+  }
+
+  // The partitioned dynamics at (x, inputs, p); the last result is reused for the same point.
+  const ReducedDynamics::Result& solve(const Eval& e) const {
+    const int nu = reduced_.nu();
+    const Vector in = inputs(e);
+    const double* p = parameters(e);
+    std::lock_guard<std::mutex> lock(mutex_);
+    Vector key(2 * nu + in.size() + g_.parameters);
+    for (int i = 0; i < 2 * nu; ++i) key[i] = e.x[i];
+    key.segment(2 * nu, in.size()) = in;
+    for (int i = 0; i < g_.parameters; ++i) key[2 * nu + in.size() + i] = p[i];
+    if (have_ && key.size() == key_.size() && key == key_) return result_;
+    try {
+      try {
+        reduced_.solve(e.x, e.x + nu, in.data(), p, last_q_, result_);
+      } catch (const std::runtime_error&) {
+        // the last solution may be far away (a new run of the same diagram): from the model's
+        // initial configuration
+        reduced_.solve(e.x, e.x + nu, in.data(), p, Eigen::Map<const Vector>(g_.initial_q, g_.n), result_);
+      }
+    } catch (const std::runtime_error& failure) {
+      // a trial state the constraints cannot be closed at: the solver retries a smaller step
+      have_ = false;
+      throw engine::OutOfDomain{failure.what()};
+    }
+    if (!result_.qdd.allFinite()) throw engine::OutOfDomain{"multibody: non-finite accelerations"};
+    last_q_ = result_.q;
+    key_ = key;
+    have_ = true;
+    return result_;
+  }
+
+  void tangent(const Eval& e, const Seeds& s, const ReducedDynamics::Result& r, Matrix& dq, Matrix& dqd,
+               Matrix& dqdd, Matrix& dinp, Matrix& dp) const {
+    const int nu = reduced_.nu(), nd = s.directions;
+    Matrix du(nu, std::max(nd, 1)), dud(nu, std::max(nd, 1));
+    dinp = Matrix::Zero(std::max(1, g_.inputs), std::max(nd, 1));
+    dp = Matrix::Zero(std::max(1, g_.parameters), std::max(nd, 1));
+    for (int d = 0; d < nd; ++d) {
+      for (int i = 0; i < nu; ++i) {
+        du(i, d) = s.x(i, d);
+        dud(i, d) = s.x(nu + i, d);
+      }
+      if (e.inputs_ready)
+        for (int k = 0; k < g_.loads + g_.driven_count; ++k)
+          for (int i = 0; i < 3; ++i) dinp(3 * k + i, d) = s.u[k](i, d);
+      if (exposed_)
+        for (int i = 0; i < g_.parameters; ++i) dp(i, d) = s.p(i, d);
+    }
+    const Vector in = inputs(e);
+    reduced_.tangent(r, in.data(), parameters(e), nd, du.data(), dud.data(), dinp.data(), dp.data(), dq, dqd, dqdd);
+  }
+
+  const GeneratedModel& g_;
+  ReducedDynamics reduced_;
+  bool exposed_;
+  const double zero_[1] = {0.0};
+  mutable std::mutex mutex_;
+  mutable Vector last_q_, key_;
+  mutable ReducedDynamics::Result result_;
+  mutable bool have_ = false;
+};
+
+std::vector<engine::ParamSpec> exposed_parameters(const GeneratedModel& g) {
+  std::vector<engine::ParamSpec> specs;
+  for (int i = 0; i < g.parameters; ++i)
+    specs.push_back({g.parameter_names[i], "", g.parameter_values[i], false, -kInf, kInf, "model parameter"});
+  ReducedDynamics reduced(g);
+  for (int j : reduced.independent())
+    specs.push_back({std::string("q0.") + g.coordinate_names[j], "m or rad", g.initial_q[j], false, -kInf, kInf,
+                     "initial value of an independent coordinate"});
+  for (int j : reduced.independent())
+    specs.push_back({std::string("qd0.") + g.coordinate_names[j], "m/s or rad/s", 0.0, false, -kInf, kInf,
+                     "initial velocity of an independent coordinate"});
+  return specs;
+}
+
+// Registers `multibody` and one `multibody.NAME` per generated model.
+struct Registration {
+  Registration() {
+    engine::Registry::global().add(
+        {"multibody", "mechanics", "A generated multibody model (setting model: NAME), with its default parameters.",
+         {},
+         {{"model", "name of a generated model (generated_models/NAME.mbs.yaml)", "", true}},
+         [](const engine::BlockSettings& s) -> std::unique_ptr<Block> {
+           const std::string name = s.text("model");
+           const GeneratedModel* g = generated::find_model(name);
+           if (!g) s.fail("model", "no generated model named '" + name + "'");
+           return std::make_unique<Multibody>(*g, false);
+         }});
+    for (const GeneratedModel* g : generated::all_models()) {
+      engine::Registry::global().add(
+          {std::string("multibody.") + g->name, "mechanics",
+           std::string("The generated multibody model ") + g->name + ", its parameters and initial state exposed.",
+           exposed_parameters(*g),
+           {},
+           [g](const engine::BlockSettings&) -> std::unique_ptr<Block> { return std::make_unique<Multibody>(*g, true); }});
+    }
+  }
+};
+const Registration registration;
+
+}  // namespace
+}  // namespace dydp::blocks

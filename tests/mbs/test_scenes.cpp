@@ -1,0 +1,123 @@
+// The multibody block in scenes: Andrews' mechanism against the published reference solution
+// at t = 0.03 s, its sensitivity to the spring stiffness against central differences of runs,
+// and energy conservation of the pendulums (energy from the numerical oracle's kinematics).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "engine/diagram.hpp"
+#include "engine/block.hpp"
+#include "engine/run.hpp"
+#include "symbolic/mbs/numeric_dynamics.hpp"
+
+namespace dydp::mbs {
+namespace {
+
+using engine::RunResult;
+
+const std::string kScenes = DYDP_SCENARIOS_DIR;
+const std::string kModels = DYDP_MODELS_DIR;
+
+std::vector<double> last_values(const RunResult& r, const std::string& port, int width) {
+  std::vector<double> v;
+  for (int i = 0; i < width; ++i) {
+    const int k = r.signal_index(port + "[" + std::to_string(i) + "]");
+    EXPECT_GE(k, 0) << port << "[" << i << "]";
+    v.push_back(r.value(static_cast<int>(r.t.size()) - 1, k));
+  }
+  return v;
+}
+
+TEST(Andrews, MatchesTheReferenceSolutionAtTheEndOfTheSpan) {
+  const engine::Diagram d = engine::load_scene(kScenes + "/andrews.yaml");
+  engine::RunOptions options;
+  options.sensitivities = false;
+  const RunResult r = engine::run(d, options);
+  ASSERT_NEAR(r.t.back(), 0.03, 1e-15);
+  // Test Set for IVP Solvers, problem andrews (RADAU5 at 1e-14), order beta ... epsilon
+  const double q_ref[7] = {15.81077119629904,  -15.75637105984298, 0.04082224013073101, -0.5347301163226948,
+                           0.5244099658805304, 0.5347301163226948, 1.048080741042263};
+  const double qd_ref[7] = {1139.920302151208,  -1424.379294994111, 11.03291221937134, 19.29337464421385,
+                            0.5735699284790808, -19.29337464421385, 0.3231791658026955};
+  const auto q = last_values(r, "andrews.q", 7);
+  const auto qd = last_values(r, "andrews.qd", 7);
+  double worst = 0.0;
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_NEAR(q[i], q_ref[i], 1e-6) << "coordinate " << i;
+    EXPECT_NEAR(qd[i], qd_ref[i], 1e-5 * std::max(1.0, std::abs(qd_ref[i]))) << "velocity " << i;
+    worst = std::max(worst, std::abs(q[i] - q_ref[i]));
+  }
+  RecordProperty("max_abs_error_q", std::to_string(worst));
+}
+
+void andrews_sensitivity();
+
+TEST(Andrews, SensitivityToTheSpringMatchesCentralDifferences) {
+  try {
+    andrews_sensitivity();
+  } catch (const engine::OutOfDomain& e) {
+    FAIL() << "out of domain: " << e.reason;
+  }
+}
+
+void andrews_sensitivity() {
+  engine::Diagram d = engine::load_scene(kScenes + "/andrews.yaml");
+  const RunResult r = engine::run(d);
+  const double c0 = 4530.0, h = 1.0;
+  engine::RunOptions plain;
+  plain.sensitivities = false;
+  d.set_parameter(0, c0 + h);
+  const RunResult plus = engine::run(d, plain);
+  d.set_parameter(0, c0 - h);
+  const RunResult minus = engine::run(d, plain);
+  const int last = static_cast<int>(r.t.size()) - 1;
+  for (int i = 0; i < 7; ++i) {
+    const int k = r.signal_index("andrews.q[" + std::to_string(i) + "]");
+    const double fd = (plus.value(last, k) - minus.value(last, k)) / (2 * h);
+    EXPECT_NEAR(r.tangent(last, 0, k), fd, 1e-4 * std::max(1e-3, std::abs(fd))) << "coordinate " << i;
+  }
+}
+
+// Total energy 1/2 qd^T M qd - sum m g . x_G along a run, relative drift.
+double energy_drift(const std::string& scene, const std::string& model_name) {
+  const engine::Diagram d = engine::load_scene(kScenes + "/" + scene);
+  engine::RunOptions options;
+  options.sensitivities = false;
+  const RunResult r = engine::run(d, options);
+  NumericDynamics oracle(load_model(kModels + "/" + model_name + ".mbs.yaml"));
+  const Model& m = oracle.model();
+  const int n = m.coordinates();
+  const Eigen::Vector3d g(m.gravity[0], m.gravity[1], m.gravity[2]);
+  double e0 = 0.0, drift = 0.0;
+  for (std::size_t s = 0; s < r.t.size(); ++s) {
+    Eigen::VectorXd q(n), qd(n);
+    for (int i = 0; i < n; ++i) {
+      q[i] = r.value(static_cast<int>(s), r.signal_index("pendulum.q" + (n > 1 ? "[" + std::to_string(i) + "]" : std::string())));
+      qd[i] = r.value(static_cast<int>(s), r.signal_index("pendulum.qd" + (n > 1 ? "[" + std::to_string(i) + "]" : std::string())));
+    }
+    const auto k = oracle.kinematics(q, qd, Eigen::VectorXd::Zero(n));
+    double energy = 0.5 * qd.dot(oracle.mass(q) * qd);
+    for (std::size_t b = 1; b < m.bodies.size(); ++b) {
+      const Body& body = m.bodies[b];
+      const Eigen::Vector3d com(m.value(body.com[0]), m.value(body.com[1]), m.value(body.com[2]));
+      const Eigen::Vector3d x = k.origin[body.frame] + k.rotation[body.frame] * com;
+      energy -= m.value(body.mass) * g.dot(x);
+    }
+    if (s == 0) e0 = energy;
+    drift = std::max(drift, std::abs(energy - e0) / std::abs(e0));
+  }
+  return drift;
+}
+
+TEST(Pendulums, ConserveEnergy) {
+  const double single = energy_drift("pendulum_energy.yaml", "pendulum");
+  const double two = energy_drift("double_pendulum_energy.yaml", "double_pendulum");
+  RecordProperty("pendulum_energy_drift", std::to_string(single));
+  RecordProperty("double_pendulum_energy_drift", std::to_string(two));
+  EXPECT_LT(single, 1e-8);
+  EXPECT_LT(two, 1e-8);
+}
+
+}  // namespace
+}  // namespace dydp::mbs
