@@ -24,6 +24,8 @@ namespace {
 
 /// What the C callbacks need, and what they found when they had to refuse a point.
 struct Problem {
+  Problem(const Diagram& diagram, Evaluator& evaluator, int states, int directions)
+      : d(diagram), ev(evaluator), nx(states), ns(directions) {}
   const Diagram& d;
   Evaluator& ev;
   int nx;                 ///< states of the diagram (CVODES gets max(nx, 1))
@@ -181,7 +183,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   Evaluator ev(d, ns > 0);
   RunResult result;
   Recorder recorder(d, ns, result, options);
-  Problem P{d, ev, nx, ns, {}, {}, {}, {}, 0.0, {}, 0, 0};
+  Problem P(d, ev, nx, ns);
   P.identity.assign(static_cast<size_t>(nx) * nx, 0.0);
   for (int i = 0; i < nx; ++i) P.identity[i * nx + i] = 1.0;
   const CpuClock clock;
