@@ -1,4 +1,5 @@
 // Math blocks: gain, sum, product (direct feedthrough) and integrator, first-order lag (states).
+#include <cmath>
 #include <string>
 
 #include "engine/registry.hpp"
@@ -179,6 +180,73 @@ const engine::BlockRegistration lag({
      {"tau", "s", 0.1, false, 1e-12, kInf, "time constant"}},
     {kWidth},
     [](const BlockSettings& s) -> std::unique_ptr<Block> { return std::make_unique<Lag>(width_of(s)); }});
+
+}  // namespace
+}  // namespace dydp::blocks
+
+namespace dydp::blocks {
+namespace {
+
+/// y = (u[i0], u[i1], ...): picks elements of a wider signal.
+class Demux : public Block {
+ public:
+  Demux(int width, std::vector<int> indices) : index_(std::move(indices)) {
+    declare_input("u", width);
+    declare_output("y", static_cast<int>(index_.size()));
+  }
+  void outputs(const Eval& e, double* const* y) const override {
+    for (size_t k = 0; k < index_.size(); ++k) y[0][k] = e.u[0][index_[k]];
+  }
+  void outputs_tangent(const Eval&, const Seeds& s, const DirView* dy) const override {
+    for (int d = 0; d < s.directions; ++d)
+      for (size_t k = 0; k < index_.size(); ++k) dy[0](static_cast<int>(k), d) = s.u[0](index_[k], d);
+  }
+
+ private:
+  std::vector<int> index_;
+};
+
+/// y = (in1, in2, ...): scalar inputs stacked into one signal.
+class Mux : public Block {
+ public:
+  explicit Mux(int n) : n_(n) {
+    for (int k = 0; k < n; ++k) declare_input("in" + std::to_string(k + 1), 1);
+    declare_output("y", n);
+  }
+  void outputs(const Eval& e, double* const* y) const override {
+    for (int k = 0; k < n_; ++k) y[0][k] = e.u[k][0];
+  }
+  void outputs_tangent(const Eval&, const Seeds& s, const DirView* dy) const override {
+    for (int d = 0; d < s.directions; ++d)
+      for (int k = 0; k < n_; ++k) dy[0](k, d) = s.u[k](0, d);
+  }
+
+ private:
+  int n_;
+};
+
+const engine::BlockRegistration demux({
+    "math.demux", "math", "y = the listed elements of u (0-based), e.g. indices: [2].", {},
+    {{"indices", "elements of u to output, 0-based", "0", false}, {"width", "width of u", "1", false}},
+    [](const BlockSettings& s) -> std::unique_ptr<Block> {
+      const int width = width_of(s);
+      std::vector<int> index;
+      for (double v : s.numbers("indices")) {
+        if (v != std::floor(v) || v < 0 || v >= width)
+          s.fail("indices", "index " + std::to_string(v) + " outside 0.." + std::to_string(width - 1));
+        index.push_back(static_cast<int>(v));
+      }
+      return std::make_unique<Demux>(width, index);
+    }});
+
+const engine::BlockRegistration mux({
+    "math.mux", "math", "y = (in1, in2, ...): scalar inputs stacked into one signal.", {},
+    {{"inputs", "number of scalar inputs", "2", false}},
+    [](const BlockSettings& s) -> std::unique_ptr<Block> {
+      const int n = s.integer("inputs");
+      if (n < 1) s.fail("inputs", "must be at least 1");
+      return std::make_unique<Mux>(n);
+    }});
 
 }  // namespace
 }  // namespace dydp::blocks
