@@ -1,7 +1,8 @@
 // multibody: a generated multibody model (generated_models/) as a block. States: the independent
 // coordinates u and velocities u_dot; dependent coordinates are solved by Newton-Raphson on the
 // generated constraints at every evaluation. Inputs: one port per load of the model (force or
-// torque, width 3, in the load's declared frame) and per driven joint (q, qd, qdd). Outputs:
+// torque in the load's declared frame, width 3 or the components declared; link force, width 1)
+// and per driven joint three scalar ports NAME, NAME_rate, NAME_acc (q, qd, qdd). Outputs:
 // q, qd, qdd (all coordinates, model order) and one port per sensor. Tangents go through the
 // generated tangent functions and the partitioning's tangent (ReducedDynamics::tangent).
 //
@@ -36,11 +37,14 @@ class Multibody : public Block {
   // `exposed`: block parameters are [model parameters, q0 of u, qd0 of u]; otherwise none.
   Multibody(const GeneratedModel& model, bool exposed)
       : g_(model), reduced_(model), exposed_(exposed), last_q_(Eigen::Map<const Vector>(model.initial_q, model.n)) {
-    for (int i = 0; i < g_.loads; ++i) {
-      std::string name = g_.input_names[3 * i];
-      declare_input(name.substr(0, name.rfind('.')), 3, "N or N m");
+    for (int i = 0; i < g_.loads; ++i) declare_input(g_.load_names[i], g_.load_widths[i], "N or N m");
+    for (int i = 0; i < g_.driven_count; ++i) {
+      // scalar ports, so that a steering source wires directly: NAME (q), NAME_rate, NAME_acc
+      const std::string joint = g_.coordinate_names[g_.driven[i]];
+      declare_input(joint, 1, "m or rad");
+      declare_input(joint + "_rate", 1, "m/s or rad/s");
+      declare_input(joint + "_acc", 1, "m/s^2 or rad/s^2");
     }
-    for (int i = 0; i < g_.driven_count; ++i) declare_input(g_.coordinate_names[g_.driven[i]], 3, "q, qd, qdd");
     const bool driven = g_.driven_count > 0;
     declare_output("q", g_.n, "m or rad", driven);
     declare_output("qd", g_.n, "m/s or rad/s", driven);
@@ -140,6 +144,10 @@ class Multibody : public Block {
   }
 
  private:
+  // Input ports: the loads (their widths), then q, qd, qdd of each driven joint (width 1 each).
+  int ports() const { return g_.loads + 3 * g_.driven_count; }
+  int port_width(int k) const { return k < g_.loads ? g_.load_widths[k] : 1; }
+
   Vector padded(const Vector& v) const { return v.size() ? v : Vector::Zero(1); }
 
   const double* parameters(const Eval& e) const {
@@ -152,9 +160,9 @@ class Multibody : public Block {
       // driven motions are needed by every output when the model has any (then all feed through)
       return in;
     }
-    const int ports = g_.loads + g_.driven_count;
-    for (int k = 0; k < ports; ++k)
-      for (int i = 0; i < 3; ++i) in[3 * k + i] = e.u[k][i];
+    int at = 0;
+    for (int k = 0; k < ports(); ++k)
+      for (int i = 0; i < port_width(k); ++i) in[at++] = e.u[k][i];
     return in;
   }
 
@@ -200,9 +208,11 @@ class Multibody : public Block {
         du(i, d) = s.x(i, d);
         dud(i, d) = s.x(nu + i, d);
       }
-      if (e.inputs_ready)
-        for (int k = 0; k < g_.loads + g_.driven_count; ++k)
-          for (int i = 0; i < 3; ++i) dinp(3 * k + i, d) = s.u[k](i, d);
+      if (e.inputs_ready) {
+        int at = 0;
+        for (int k = 0; k < ports(); ++k)
+          for (int i = 0; i < port_width(k); ++i) dinp(at++, d) = s.u[k](i, d);
+      }
       if (exposed_)
         for (int i = 0; i < g_.parameters; ++i) dp(i, d) = s.p(i, d);
     }

@@ -2,6 +2,7 @@
 #include "generate_mbs.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <sstream>
 
 #include "symbolic/differentiate.hpp"
@@ -111,15 +112,17 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
     return result;
   }
 
-  std::vector<EmittedFunction> dynamics, kinematics;
+  // Four translation units, so that a large model's code compiles in parallel: dynamics (M and
+  // the residual), its tangent, kinematics (constraints), sensors and Jacobians.
+  std::vector<EmittedFunction> dynamics, residual_tangent, kinematics, sensors;
   dynamics.push_back(seeded_fn(name + "_mass", *lists.inertial, {lists.qdd}));
   dynamics.push_back(plain(name + "_residual", *lists.residual));
-  dynamics.push_back(tangent(name + "_residual_tangent", *lists.residual, all_seeded));
+  residual_tangent.push_back(tangent(name + "_residual_tangent", *lists.residual, all_seeded));
   kinematics.push_back(plain(name + "_constraints", *lists.constraints));
   kinematics.push_back(tangent(name + "_velocity_constraints_tangent", *lists.velocity_constraints, all_seeded));
-  kinematics.push_back(plain(name + "_sensors", *lists.sensors));
-  kinematics.push_back(tangent(name + "_sensors_tangent", *lists.sensors, all_seeded));
-  for (const auto& j : lists.jacobians) kinematics.push_back(plain(j.name, *j.list));
+  sensors.push_back(plain(name + "_sensors", *lists.sensors));
+  sensors.push_back(tangent(name + "_sensors_tangent", *lists.sensors, all_seeded));
+  for (const auto& j : lists.jacobians) sensors.push_back(plain(j.name, *j.list));
 
   bool automatic = false;
   const std::vector<int> independent = choose_independent(model, automatic);
@@ -127,14 +130,16 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   for (int j : independent) result.independent.push_back(model.joints[j].name);
 
   std::vector<EmittedFunction> all = dynamics;
-  all.insert(all.end(), kinematics.begin(), kinematics.end());
+  for (const auto* part : {&residual_tangent, &kinematics, &sensors}) all.insert(all.end(), part->begin(), part->end());
   const std::string header = name + ".hpp";
   std::string header_text = emit_header_file(all, emit);
   header_text += "\n#include \"symbolic/mbs/generated_model.hpp\"\n\nnamespace dydp::generated {\nextern const dydp::mbs::GeneratedModel " +
                  name + "_model;\n}  // namespace dydp::generated\n";
   write_atomically(options.out_dir / header, header_text);
   write_atomically(options.out_dir / (name + "_dynamics.cpp"), emit_source_file(dynamics, header, emit));
+  write_atomically(options.out_dir / (name + "_residual_tangent.cpp"), emit_source_file(residual_tangent, header, emit));
   write_atomically(options.out_dir / (name + "_kinematics.cpp"), emit_source_file(kinematics, header, emit));
+  write_atomically(options.out_dir / (name + "_sensors.cpp"), emit_source_file(sensors, header, emit));
 
   // The descriptor.
   std::vector<std::string> coordinates, parameters;
@@ -161,8 +166,18 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   for (const auto& sensor : model.sensors) {
     sensor_ports.push_back(sensor.name);
     sensor_widths.push_back(sensor.width());
-    sensor_acc.push_back(sensor.type == mbs::Sensor::Type::Acceleration || sensor.type == mbs::Sensor::Type::Joint);
+    const bool reads_qdd = std::find(sensor.components.begin(), sensor.components.end(), 2) != sensor.components.end();
+    sensor_acc.push_back(sensor.type == mbs::Sensor::Type::Acceleration ||
+                         (sensor.type == mbs::Sensor::Type::Joint && reads_qdd));
   }
+  std::vector<std::string> load_names;
+  std::vector<int> load_widths;
+  for (const auto& load : model.loads) {
+    load_names.push_back(load.name);
+    load_widths.push_back(load.width());
+  }
+  d += string_array("load_names", load_names);
+  d += number_array("int", "load_widths", load_widths);
   d += string_array("sensor_ports", sensor_ports);
   d += number_array("int", "sensor_widths", sensor_widths);
   d += number_array("int", "sensor_reads_acceleration", sensor_acc);
@@ -180,7 +195,8 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += "    " + std::to_string(sensor_ports.size()) + ", sensor_ports, sensor_widths, sensor_reads_acceleration, initial_q,\n";
   d += "    " + std::to_string(driven.size()) + ", driven, " + std::to_string(independent.size()) + ", independent,\n";
   d += "    " + name + "_mass, " + name + "_residual, " + name + "_residual_tangent, " + name + "_constraints,\n";
-  d += "    " + name + "_velocity_constraints_tangent, " + name + "_sensors, " + name + "_sensors_tangent};\n\n";
+  d += "    " + name + "_velocity_constraints_tangent, " + name + "_sensors, " + name + "_sensors_tangent,\n";
+  d += "    " + std::to_string(model.load_input_count()) + ", load_names, load_widths};\n\n";
   d += "}  // namespace dydp::generated\n";
   write_atomically(options.out_dir / (name + "_model.cpp"), d);
   return result;

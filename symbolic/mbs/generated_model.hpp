@@ -24,8 +24,8 @@ struct GeneratedModel {
   const char* name;
   int n;           // coordinates
   int m;           // constraints
-  int inputs;      // 3 per load, then q, qd, qdd of each driven joint
-  int loads;       // number of loads (the first 3 * loads inputs)
+  int inputs;      // the loads' components, then q, qd, qdd of each driven joint
+  int loads;       // number of loads (their inputs: load_inputs, load_widths below)
   int parameters;  // symbolic parameters
   int sensor_outputs;
   const char* const* coordinate_names;
@@ -49,6 +49,11 @@ struct GeneratedModel {
   GeneratedTangent velocity_constraints_tangent;   // h (m), J qd (m)
   GeneratedFunction sensors;
   GeneratedTangent sensors_tangent;
+  // Load ports: the first `load_inputs` inputs, load_widths[i] of them for load i (3 for a force
+  // or torque, fewer with components, 1 for a link force).
+  int load_inputs;
+  const char* const* load_names;
+  const int* load_widths;
 };
 
 }  // namespace dydp::mbs

@@ -3,6 +3,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -96,6 +97,26 @@ class Loader {
     fail(node, field, "body '" + m_.bodies[p.body].name + "' has no anchor '" + anchor + "'");
   }
 
+  // A non-empty list of distinct names out of `names`, as indices.
+  std::vector<int> components(const YAML::Node& node, const std::string& field,
+                              const std::vector<std::string>& names) const {
+    std::string allowed;
+    for (const auto& n : names) allowed += (allowed.empty() ? "" : ", ") + n;
+    if (!node.IsSequence() || node.size() == 0) fail(node, field, "expected a non-empty list of " + allowed);
+    std::vector<int> picked;
+    for (std::size_t k = 0; k < node.size(); ++k) {
+      const std::string s = text(node[k], field);
+      int found = -1;
+      for (std::size_t i = 0; i < names.size(); ++i)
+        if (names[i] == s) found = static_cast<int>(i);
+      if (found < 0) fail(node[k], field, "expected one of " + allowed + ", got '" + s + "'");
+      for (int p : picked)
+        if (p == found) fail(node[k], field, "'" + s + "' is listed twice");
+      picked.push_back(found);
+    }
+    return picked;
+  }
+
   int joint_index(const YAML::Node& node, const std::string& field) const {
     const std::string s = text(node, field);
     for (std::size_t i = 0; i < m_.joints.size(); ++i)
@@ -181,17 +202,34 @@ class Loader {
       for (std::size_t k = 0; k < js.size(); ++k) {
         const YAML::Node j = js[k];
         const std::string jf = field + ".joints[" + std::to_string(k) + "]";
-        check_keys(j, jf, {"name", "type", "driven", "initial"});
+        check_keys(j, jf, {"name", "type", "axis", "driven", "initial"});
         Joint joint;
         joint.name = j["name"] ? text(j["name"], jf + ".name") : body.name + "_" + std::to_string(k + 1);
         for (const Joint& other : m_.joints)
           if (other.name == joint.name) fail(j, jf + ".name", "duplicate joint name '" + joint.name + "'");
-        if (!j["type"]) fail(j, jf, "missing type (Rx Ry Rz Tx Ty Tz)");
+        if (!j["type"]) fail(j, jf, "missing type (Rx Ry Rz Tx Ty Tz, or R T with an axis)");
         static const std::map<std::string, JointType> types{{"Rx", JointType::Rx}, {"Ry", JointType::Ry},
-            {"Rz", JointType::Rz}, {"Tx", JointType::Tx}, {"Ty", JointType::Ty}, {"Tz", JointType::Tz}};
+            {"Rz", JointType::Rz}, {"Tx", JointType::Tx}, {"Ty", JointType::Ty}, {"Tz", JointType::Tz},
+            {"R", JointType::R}, {"T", JointType::T}};
         const auto t = types.find(text(j["type"], jf + ".type"));
-        if (t == types.end()) fail(j["type"], jf + ".type", "expected one of Rx Ry Rz Tx Ty Tz");
+        if (t == types.end()) fail(j["type"], jf + ".type", "expected one of Rx Ry Rz Tx Ty Tz R T");
         joint.type = t->second;
+        if (axis_of(joint.type) >= 0) {
+          if (j["axis"]) fail(j["axis"], jf + ".axis", "only joints of type R or T take an axis");
+          joint.axis = {0.0, 0.0, 0.0};
+          joint.axis[axis_of(joint.type)] = 1.0;
+        } else {
+          const YAML::Node a = j["axis"];
+          if (!a) fail(j, jf + ".axis", "missing (a joint of type R or T needs an axis [x, y, z])");
+          if (!a.IsSequence() || a.size() != 3) fail(a, jf + ".axis", "expected [x, y, z]");
+          double norm = 0.0;
+          for (int i = 0; i < 3; ++i) {
+            joint.axis[i] = number(a[i], jf + ".axis");
+            norm += joint.axis[i] * joint.axis[i];
+          }
+          if (norm < 1e-24) fail(a, jf + ".axis", "the axis is zero");
+          for (double& c : joint.axis) c /= std::sqrt(norm);
+        }
         joint.parent = parent_joint;
         if (k == 0) joint.offset = offset;
         if (j["driven"]) joint.driven = j["driven"].as<bool>();
@@ -294,7 +332,8 @@ class Loader {
       for (std::size_t i = 0; i < ls.size(); ++i) {
         const YAML::Node l = ls[i];
         std::string field = "loads[" + std::to_string(i) + "]";
-        check_keys(l, field, {"name", "type", "point", "body", "frame"});
+        check_keys(l, field, {"name", "type", "point", "body", "frame", "components", "a", "b", "sense",
+                              "reaction"});
         Load load;
         if (!l["name"]) fail(l, field, "missing name");
         load.name = text(l["name"], field + ".name");
@@ -308,8 +347,28 @@ class Loader {
           load.type = Load::Type::Torque;
           if (!l["body"]) fail(l, field + ".body", "missing");
           load.point.body = body_index(l["body"], text(l["body"], field + ".body"), field + ".body");
+          if (l["reaction"])
+            load.reaction = body_index(l["reaction"], text(l["reaction"], field + ".reaction"), field + ".reaction");
+        } else if (type == "link_force") {
+          load.type = Load::Type::LinkForce;
+          if (!l["a"] || !l["b"]) fail(l, field, "needs points a and b (BODY.ANCHOR)");
+          load.point = point(l["a"], field + ".a");
+          load.b = point(l["b"], field + ".b");
+          const std::string sense = l["sense"] ? text(l["sense"], field + ".sense") : "tension";
+          if (sense != "tension" && sense != "compression")
+            fail(l["sense"], field + ".sense", "expected tension or compression");
+          load.compression = sense == "compression";
+          for (const char* key : {"frame", "components", "point", "body", "reaction"})
+            if (l[key]) fail(l[key], field + "." + key, "not a key of a link force");
         } else {
-          fail(l["type"] ? l["type"] : l, field + ".type", "expected force or torque");
+          fail(l["type"] ? l["type"] : l, field + ".type", "expected force, torque or link_force");
+        }
+        if (load.type == Load::Type::Force && l["reaction"])
+          fail(l["reaction"], field + ".reaction", "only a torque takes a reaction body");
+        if (load.type != Load::Type::LinkForce) {
+          for (const char* key : {"a", "b", "sense"})
+            if (l[key]) fail(l[key], field + "." + key, "only a link force takes " + std::string(key));
+          if (l["components"]) load.components = components(l["components"], field + ".components", {"x", "y", "z"});
         }
         load.frame = frame(l, field);
         m_.loads.push_back(load);
@@ -320,7 +379,8 @@ class Loader {
       for (std::size_t i = 0; i < ss.size(); ++i) {
         const YAML::Node s = ss[i];
         std::string field = "sensors[" + std::to_string(i) + "]";
-        check_keys(s, field, {"name", "type", "point", "a", "b", "frame", "joint"});
+        check_keys(s, field, {"name", "type", "point", "body", "a", "b", "frame", "joint", "components", "reference",
+                              "sense"});
         Sensor sensor;
         if (!s["name"]) fail(s, field, "missing name");
         sensor.name = text(s["name"], field + ".name");
@@ -328,15 +388,28 @@ class Loader {
         const std::string type = s["type"] ? text(s["type"], field + ".type") : "";
         static const std::map<std::string, Sensor::Type> types{{"position", Sensor::Type::Position},
             {"velocity", Sensor::Type::Velocity}, {"acceleration", Sensor::Type::Acceleration},
-            {"length", Sensor::Type::Length}, {"joint", Sensor::Type::Joint}};
+            {"length", Sensor::Type::Length}, {"joint", Sensor::Type::Joint},
+            {"angular_velocity", Sensor::Type::AngularVelocity}};
         const auto t = types.find(type);
         if (t == types.end()) fail(s["type"] ? s["type"] : s, field + ".type",
-                                   "expected position, velocity, acceleration, length or joint");
+                                   "expected position, velocity, acceleration, angular_velocity, length or joint");
         sensor.type = t->second;
+        if (sensor.type != Sensor::Type::Length)
+          for (const char* key : {"reference", "sense"})
+            if (s[key]) fail(s[key], field + "." + key, "only a length sensor takes " + std::string(key));
         if (sensor.type == Sensor::Type::Length) {
           if (!s["a"] || !s["b"]) fail(s, field, "needs points a and b");
           sensor.a = point(s["a"], field + ".a");
           sensor.b = point(s["b"], field + ".b");
+          if (s["reference"]) sensor.reference = value(s["reference"], field + ".reference");
+          const std::string sense = s["sense"] ? text(s["sense"], field + ".sense") : "extension";
+          if (sense != "extension" && sense != "compression")
+            fail(s["sense"], field + ".sense", "expected extension or compression");
+          sensor.compression = sense == "compression";
+        } else if (sensor.type == Sensor::Type::AngularVelocity) {
+          if (!s["body"]) fail(s, field + ".body", "missing");
+          sensor.a.body = body_index(s["body"], text(s["body"], field + ".body"), field + ".body");
+          sensor.frame = frame(s, field);
         } else if (sensor.type == Sensor::Type::Joint) {
           if (!s["joint"]) fail(s, field + ".joint", "missing");
           sensor.joint = joint_index(s["joint"], field + ".joint");
@@ -344,6 +417,14 @@ class Loader {
           if (!s["point"]) fail(s, field + ".point", "missing");
           sensor.a = point(s["point"], field + ".point");
           sensor.frame = frame(s, field);
+        }
+        std::vector<std::string> names{"x", "y", "z"};
+        if (sensor.type == Sensor::Type::Length) names = {"length", "rate"};
+        if (sensor.type == Sensor::Type::Joint) names = {"q", "qd", "qdd"};
+        if (s["components"]) {
+          sensor.components = components(s["components"], field + ".components", names);
+        } else {
+          for (int c = 0; c < sensor.full_width(); ++c) sensor.components.push_back(c);
         }
         m_.sensors.push_back(sensor);
       }
@@ -389,14 +470,22 @@ std::vector<int> Model::driven_joints() const {
   return d;
 }
 
-int Model::input_count() const {
-  return 3 * static_cast<int>(loads.size()) + 3 * static_cast<int>(driven_joints().size());
+int Model::load_input_count() const {
+  int n = 0;
+  for (const Load& l : loads) n += l.width();
+  return n;
 }
+
+int Model::input_count() const { return load_input_count() + 3 * static_cast<int>(driven_joints().size()); }
 
 std::vector<std::string> Model::input_names() const {
   std::vector<std::string> names;
-  for (const Load& l : loads)
-    for (const char* c : {"x", "y", "z"}) names.push_back(l.name + "." + c);
+  static const char* const xyz[] = {"x", "y", "z"};
+  for (const Load& l : loads) {
+    if (l.type == Load::Type::LinkForce) names.push_back(l.name);
+    else
+      for (int c : l.components) names.push_back(l.name + "." + xyz[c]);
+  }
   for (int k : driven_joints())
     for (const char* c : {"q", "qd", "qdd"}) names.push_back(joints[k].name + "." + c);
   return names;
@@ -411,14 +500,11 @@ int Model::symbolic_parameter_count() const {
 std::vector<std::string> Model::sensor_output_names() const {
   std::vector<std::string> names;
   for (const Sensor& s : sensors) {
-    if (s.type == Sensor::Type::Length) {
-      names.push_back(s.name + ".length");
-      names.push_back(s.name + ".rate");
-    } else if (s.type == Sensor::Type::Joint) {
-      for (const char* c : {"q", "qd", "qdd"}) names.push_back(s.name + "." + c);
-    } else {
-      for (const char* c : {"x", "y", "z"}) names.push_back(s.name + "." + c);
-    }
+    static const char* const xyz[] = {"x", "y", "z"};
+    static const char* const length[] = {"length", "rate"};
+    static const char* const joint[] = {"q", "qd", "qdd"};
+    const char* const* parts = s.type == Sensor::Type::Length ? length : s.type == Sensor::Type::Joint ? joint : xyz;
+    for (int c : s.components) names.push_back(s.name + "." + parts[c]);
   }
   return names;
 }

@@ -24,16 +24,23 @@ struct Parameter {
   bool symbolic = true;  // kept as a symbol (a sensitivity direction) or folded as a constant
 };
 
-enum class JointType { Rx, Ry, Rz, Tx, Ty, Tz };
-inline bool is_revolute(JointType t) { return t == JointType::Rx || t == JointType::Ry || t == JointType::Rz; }
-inline int axis_of(JointType t) { return static_cast<int>(t) % 3; }
+// R and T: about / along an arbitrary unit axis (Joint::axis) of the frame the joint starts from.
+enum class JointType { Rx, Ry, Rz, Tx, Ty, Tz, R, T };
+inline bool is_revolute(JointType t) {
+  return t == JointType::Rx || t == JointType::Ry || t == JointType::Rz || t == JointType::R;
+}
+// 0, 1, 2 for the frame's own axes, -1 for an arbitrary axis.
+inline int axis_of(JointType t) { return t == JointType::R || t == JointType::T ? -1 : static_cast<int>(t) % 3; }
 
 // One 1-DOF joint: a rotation about, or a translation along, an axis of the frame it starts from.
 // Joint k's frame = frame of `parent` (a joint index, -1 for ground) moved by `offset` (parent
-// frame), then by the joint motion. Coordinate q[k] belongs to joint k.
+// frame), then by the joint motion. Coordinate q[k] belongs to joint k. A rotation about an
+// arbitrary axis a is R = cos q I + sin q [a]x + (1 - cos q) a a^T, so at q = 0 the joint frame
+// is parallel to its parent's (hardpoints of a whole suspension can be written in one frame).
 struct Joint {
   std::string name;
   JointType type = JointType::Rz;
+  std::array<double, 3> axis{0.0, 0.0, 1.0};  // unit, parent-frame components (set for every type)
   int parent = -1;
   Vec3Value offset{};
   bool driven = false;   // q, qd, qdd come from inputs
@@ -82,22 +89,39 @@ struct ForceElement {
   Value value;
 };
 
-// External loads, inputs of the model: a force (3 components) at a point, or a torque (3) on a
-// body, components in the frame of body `frame` (0 = ground).
+// External loads, inputs of the model: a force at a point, or a torque on a body, components in
+// the frame of body `frame` (0 = ground), all three or the subset `components` (one input each);
+// or a link force: one input, the magnitude of equal and opposite forces at points a and b along
+// the line between them, positive pulling them together (`tension`) or pushing them apart
+// (`compression`, the convention of the spring blocks). A torque may react on a second body
+// (`reaction`): a drive or brake torque between a wheel and its upright.
 struct Load {
   std::string name;
-  enum class Type { Force, Torque } type = Type::Force;
-  PointRef point;  // force: the point; torque: point.body is the body
+  enum class Type { Force, Torque, LinkForce } type = Type::Force;
+  PointRef point;  // force: the point; torque: point.body is the body; link force: point a
+  PointRef b;      // link force: point b
   int frame = 0;
+  std::vector<int> components{0, 1, 2};
+  bool compression = false;  // link force: positive pushes apart
+  int reaction = -1;         // torque: the body the opposite torque acts on (-1: none)
+  int width() const { return type == Type::LinkForce ? 1 : static_cast<int>(components.size()); }
 };
 
+// Sensors. Position, velocity, acceleration of a point and angular velocity of a body (x, y, z in
+// the frame of body `frame`); length of the line a-b and its rate (or, with `compression`,
+// reference - length and its rate); joint q, qd, qdd. `components` keeps a subset of the
+// outputs, in the order given (x y z; length rate; q qd qdd).
 struct Sensor {
   std::string name;
-  enum class Type { Position, Velocity, Acceleration, Length, Joint } type = Type::Position;
-  PointRef a, b;  // b: for Length
+  enum class Type { Position, Velocity, Acceleration, AngularVelocity, Length, Joint } type = Type::Position;
+  PointRef a, b;  // b: for Length; AngularVelocity: a.body is the body
   int frame = 0;  // components in this body's frame (0 = ground)
   int joint = -1;
-  int width() const { return type == Type::Length ? 2 : 3; }
+  Value reference;           // length: subtracted from (compression) or subtracted (extension)
+  bool compression = false;  // length: reference - length, -rate
+  std::vector<int> components;  // indices of the kept outputs
+  int full_width() const { return type == Type::Length ? 2 : 3; }
+  int width() const { return static_cast<int>(components.size()); }
 };
 
 // The Jacobian d(position of point)/dq, components in the ground frame, 3 x n row-major.
@@ -123,8 +147,9 @@ struct Model {
 
   int coordinates() const { return static_cast<int>(joints.size()); }
   int constraint_count() const;
-  // Inputs: 3 per load, then q, qd, qdd of every driven joint.
+  // Inputs: the loads' components (Load::width each), then q, qd, qdd of every driven joint.
   int input_count() const;
+  int load_input_count() const;
   std::vector<std::string> input_names() const;
   std::vector<int> driven_joints() const;
   int symbolic_parameter_count() const;

@@ -191,10 +191,22 @@ class Generator {
     return r;
   }
 
+  // The joint's axis (constants), own and parent components alike.
+  V3 joint_axis(int k) {
+    const Joint& j = m_.joints[k];
+    return {{ctx_->constant(j.axis[0]), ctx_->constant(j.axis[1]), ctx_->constant(j.axis[2])}};
+  }
+
   // Relative rotation of joint k (its frame to its parent's): v_parent = R v_k.
   V3 rotate(int k, const V3& v) {
     const Joint& j = m_.joints[k];
     if (!is_revolute(j.type)) return v;
+    if (axis_of(j.type) < 0) {
+      const auto& R = relative_[k];
+      V3 r;
+      for (int i = 0; i < 3; ++i) r[i] = R[i][0] * v[0] + R[i][1] * v[1] + R[i][2] * v[2];
+      return r;
+    }
     const int a = axis_of(j.type), i = (a + 1) % 3, l = (a + 2) % 3;
     const Expr c = cos_[k], s = sin_[k];
     V3 r = v;
@@ -205,6 +217,12 @@ class Generator {
   V3 rotate_back(int k, const V3& v) {
     const Joint& j = m_.joints[k];
     if (!is_revolute(j.type)) return v;
+    if (axis_of(j.type) < 0) {
+      const auto& R = relative_[k];
+      V3 r;
+      for (int i = 0; i < 3; ++i) r[i] = R[0][i] * v[0] + R[1][i] * v[1] + R[2][i] * v[2];
+      return r;
+    }
     const int a = axis_of(j.type), i = (a + 1) % 3, l = (a + 2) % 3;
     const Expr c = cos_[k], s = sin_[k];
     V3 r = v;
@@ -216,7 +234,7 @@ class Generator {
   V3 joint_offset(int k) {
     const Joint& j = m_.joints[k];
     V3 r = vec(j.offset);
-    if (!is_revolute(j.type)) r[axis_of(j.type)] = r[axis_of(j.type)] + ctx_->element(out_.q, k);
+    if (!is_revolute(j.type)) r = r + ctx_->element(out_.q, k) * joint_axis(k);
     return r;
   }
 
@@ -226,9 +244,21 @@ class Generator {
     rot_.resize(n);
     origin_.resize(n);
     offset_.resize(n);
+    relative_.resize(n);
     for (int k = 0; k < n; ++k) {
       cos_.push_back(symbolic::cos(ctx_->element(out_.q, k)));
       sin_.push_back(symbolic::sin(ctx_->element(out_.q, k)));
+      const Joint& j = m_.joints[k];
+      if (!is_revolute(j.type) || axis_of(j.type) >= 0) continue;
+      // R = cos q I + sin q [a]x + (1 - cos q) a a^T
+      const auto& a = j.axis;
+      const double skew[3][3] = {{0.0, -a[2], a[1]}, {a[2], 0.0, -a[0]}, {-a[1], a[0], 0.0}};
+      const Expr versine = all_->assign("VC" + std::to_string(k + 1), 1.0 - cos_[k]);
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+          relative_[k][r][c] = all_->assign("RJ" + std::to_string(r + 1) + std::to_string(c + 1) + "_" + std::to_string(k + 1),
+                                            (r == c ? cos_[k] : ctx_->zero()) + skew[r][c] * sin_[k] +
+                                                (a[r] * a[c]) * versine);
     }
     for (const int k : m_.order) {
       const Joint& j = m_.joints[k];
@@ -236,7 +266,11 @@ class Generator {
       const V3 parent_origin = j.parent >= 0 ? origin_[j.parent] : zero3();
       offset_[k] = joint_offset(k);
       Rot r = parent;
-      if (is_revolute(j.type)) {
+      if (is_revolute(j.type) && axis_of(j.type) < 0) {
+        for (int c = 0; c < 3; ++c)
+          r.col[c] = relative_[k][0][c] * parent.col[0] + relative_[k][1][c] * parent.col[1] +
+                     relative_[k][2][c] * parent.col[2];
+      } else if (is_revolute(j.type)) {
         const int a = axis_of(j.type), i = (a + 1) % 3, l = (a + 2) % 3;
         r.col[i] = cos_[k] * parent.col[i] + sin_[k] * parent.col[l];
         r.col[l] = -sin_[k] * parent.col[i] + cos_[k] * parent.col[l];
@@ -257,7 +291,7 @@ class Generator {
       const V3 wp = j.parent >= 0 ? omega_[j.parent] : zero3();
       const V3 vp = j.parent >= 0 ? velocity_[j.parent] : zero3();
       const Expr qd = ctx_->element(out_.qd, k);
-      const V3 e = unit(axis_of(j.type));
+      const V3 e = joint_axis(k);
       V3 w = rotate_back(k, wp), v = rotate_back(k, vp + cross(wp, offset_[k]));
       if (is_revolute(j.type)) w = w + qd * e;
       else v = v + qd * e;
@@ -294,7 +328,7 @@ class Generator {
       V3 accp = zero3();
       if (j.parent >= 0) accp = acc[j.parent];
       else if (full) accp = -V3{{ctx_->constant(m_.gravity[0]), ctx_->constant(m_.gravity[1]), ctx_->constant(m_.gravity[2])}};
-      const V3 e = unit(axis_of(j.type));
+      const V3 e = joint_axis(k);
       const Expr qd = full ? ctx_->element(out_.qd, k) : ctx_->zero();
       const V3 r = offset_[k];
       V3 a = rotate_back(k, accp + cross(ap, r) + cross(wp, cross(wp, r)));
@@ -323,14 +357,27 @@ class Generator {
     };
     std::vector<Expr> joint_force(n, ctx_->zero());
     if (full) {
-      for (std::size_t i = 0; i < m_.loads.size(); ++i) {
-        const Load& l = m_.loads[i];
-        const V3 given{{ctx_->element(out_.inp, 3 * i), ctx_->element(out_.inp, 3 * i + 1), ctx_->element(out_.inp, 3 * i + 2)}};
+      int at = 0;
+      for (const Load& l : m_.loads) {
+        if (l.type == Load::Type::LinkForce) {
+          const V3 d = point_position(l.b) - point_position(l.point);
+          const Expr length = all_->assign("LL" + std::to_string(at + 1), symbolic::sqrt(dot(d, d)));
+          const Expr magnitude = ctx_->element(out_.inp, at++);
+          const V3 f = ((l.compression ? magnitude : -magnitude) / length) * d;  // on b
+          apply(l.b, f);
+          apply(l.point, -f);
+          continue;
+        }
+        V3 given = zero3();
+        for (int c : l.components) given[c] = ctx_->element(out_.inp, at++);
         const V3 ground = body_rotation(l.frame).apply(given);
         if (l.type == Load::Type::Force) {
           apply(l.point, ground);
-        } else if (l.point.body != 0) {
-          ext_n[l.point.body] = ext_n[l.point.body] + body_rotation(l.point.body).apply_transpose(ground);
+        } else {
+          if (l.point.body != 0)
+            ext_n[l.point.body] = ext_n[l.point.body] + body_rotation(l.point.body).apply_transpose(ground);
+          if (l.reaction > 0)
+            ext_n[l.reaction] = ext_n[l.reaction] - body_rotation(l.reaction).apply_transpose(ground);
         }
       }
       int row = 0;
@@ -389,7 +436,7 @@ class Generator {
       }
       f = assign("F" + tag, k, f);
       t = assign("N" + tag, k, t);
-      const V3 e = unit(axis_of(j.type));
+      const V3 e = joint_axis(k);
       q_force[k] = all_->assign("Q" + tag + std::to_string(k + 1), (is_revolute(j.type) ? dot(e, t) : dot(e, f)) - joint_force[k]);
       if (j.parent >= 0) {
         const V3 fp = rotate(k, f);
@@ -431,6 +478,11 @@ class Generator {
       const std::string name = "SENS" + std::to_string(index) + "_";
       V3 v;
       switch (s.type) {
+        case Sensor::Type::AngularVelocity: {
+          const int f = m_.bodies[s.a.body].frame;
+          v = body_rotation(s.frame).apply_transpose(f < 0 ? zero3() : rot_[f].apply(omega_[f]));
+          break;
+        }
         case Sensor::Type::Position:
           v = body_rotation(s.frame).apply_transpose(point_position(s.a) - body_origin(s.frame));
           break;
@@ -442,13 +494,14 @@ class Generator {
         case Sensor::Type::Length: {
           const V3 d = assign(name + "D", 0, point_position(s.b) - point_position(s.a));
           const Expr length = all_->assign(name + "L", symbolic::sqrt(dot(d, d)));
-          values.push_back(length);
-          values.push_back(all_->assign(name + "LD", dot(d, point_velocity(s.b) - point_velocity(s.a)) / length));
-          continue;
+          const Expr rate = dot(d, point_velocity(s.b) - point_velocity(s.a)) / length;
+          const Expr extension = length - val(s.reference);
+          v = V3{{s.compression ? -extension : extension, s.compression ? -rate : rate, ctx_->zero()}};
+          break;
         }
       }
       v = assign(name, 0, v);
-      values.insert(values.end(), v.c.begin(), v.c.end());
+      for (int c : s.components) values.push_back(v[c]);
     }
     return values;
   }
@@ -459,6 +512,7 @@ class Generator {
   std::unique_ptr<EquationList> all_;
   std::vector<int> param_index_;
   std::vector<Expr> cos_, sin_;
+  std::vector<std::array<std::array<Expr, 3>, 3>> relative_;  // R of joints about arbitrary axes
   std::vector<Rot> rot_;
   std::vector<V3> origin_, offset_, omega_, velocity_, full_alpha_, full_acc_;
 };

@@ -9,15 +9,10 @@ namespace {
 using V3 = Eigen::Vector3d;
 using M3 = Eigen::Matrix3d;
 
-V3 unit(int axis) {
-  V3 e = V3::Zero();
-  e[axis] = 1.0;
-  return e;
-}
+// The joint's axis, parent-frame components.
+V3 axis_of_joint(const Joint& joint) { return V3(joint.axis[0], joint.axis[1], joint.axis[2]); }
 
-M3 rotation_about(int axis, double angle) {
-  return Eigen::AngleAxisd(angle, unit(axis)).toRotationMatrix();
-}
+M3 rotation_about(const V3& axis, double angle) { return Eigen::AngleAxisd(angle, axis).toRotationMatrix(); }
 
 }  // namespace
 
@@ -56,10 +51,10 @@ NumericDynamics::Kinematics NumericDynamics::kinematics(const Vector& q, const V
       ap = k.alpha[joint.parent];
       acc_p = k.acceleration[joint.parent];
     }
-    const int axis = axis_of(joint.type);
-    const V3 a = Rp * unit(axis);  // joint axis, ground components
+    const V3 axis = axis_of_joint(joint);
+    const V3 a = Rp * axis;  // joint axis, ground components
     V3 local = vec(joint.offset);
-    if (!is_revolute(joint.type)) local[axis] += q[j];
+    if (!is_revolute(joint.type)) local += q[j] * axis;
     const V3 r = Rp * local;
     k.origin[j] = xp + r;
     if (is_revolute(joint.type)) {
@@ -121,11 +116,23 @@ NumericDynamics::Vector NumericDynamics::residual(const Vector& q, const Vector&
     force[p.body] += f;
     torque[p.body] += (point_position(k, p) - frame_origin(k, p.body)).cross(f);
   };
-  for (std::size_t i = 0; i < model_.loads.size(); ++i) {
-    const Load& l = model_.loads[i];
-    const V3 v = frame_rotation(k, l.frame) * V3(inputs[3 * i], inputs[3 * i + 1], inputs[3 * i + 2]);
+  int at = 0;
+  for (const Load& l : model_.loads) {
+    if (l.type == Load::Type::LinkForce) {
+      const V3 d = point_position(k, l.b) - point_position(k, l.point);
+      const V3 f = (l.compression ? 1.0 : -1.0) * inputs[at++] * d / d.norm();  // on b
+      apply(l.b, f);
+      apply(l.point, -f);
+      continue;
+    }
+    V3 given = V3::Zero();
+    for (int c : l.components) given[c] = inputs[at++];
+    const V3 v = frame_rotation(k, l.frame) * given;
     if (l.type == Load::Type::Force) apply(l.point, v);
-    else if (l.point.body != 0) torque[l.point.body] += v;
+    else {
+      if (l.point.body != 0) torque[l.point.body] += v;
+      if (l.reaction > 0) torque[l.reaction] -= v;
+    }
   }
   int row = 0;
   for (const Cut& c : model_.cuts) {
@@ -185,7 +192,7 @@ NumericDynamics::Vector NumericDynamics::residual(const Vector& q, const Vector&
   for (int j = 0; j < n; ++j) {
     const Joint& joint = model_.joints[j];
     const M3 Rp = joint.parent >= 0 ? k.rotation[joint.parent] : M3::Identity();
-    const V3 a = Rp * unit(axis_of(joint.type));
+    const V3 a = Rp * axis_of_joint(joint);
     r[j] = (is_revolute(joint.type) ? a.dot(t[j]) : a.dot(f[j])) - joint_force[j];
   }
   return r;
@@ -236,7 +243,7 @@ NumericDynamics::Matrix NumericDynamics::point_jacobian(const Vector& q, PointRe
     if (frame < 0 || !is_ancestor(j, frame)) continue;
     const Joint& joint = model_.joints[j];
     const M3 Rp = joint.parent >= 0 ? k.rotation[joint.parent] : M3::Identity();
-    const V3 a = Rp * unit(axis_of(joint.type));
+    const V3 a = Rp * axis_of_joint(joint);
     J.col(j) = is_revolute(joint.type) ? V3(a.cross(x - k.origin[j])) : a;
   }
   return J;
@@ -285,6 +292,11 @@ NumericDynamics::Vector NumericDynamics::sensors(const Vector& q, const Vector& 
     const M3 RF = frame_rotation(k, s.frame);
     V3 v;
     switch (s.type) {
+      case Sensor::Type::AngularVelocity: {
+        const int f = model_.bodies[s.a.body].frame;
+        v = RF.transpose() * (f < 0 ? V3::Zero() : V3(k.omega[f]));
+        break;
+      }
       case Sensor::Type::Position: v = RF.transpose() * (point_position(k, s.a) - frame_origin(k, s.frame)); break;
       case Sensor::Type::Velocity: v = RF.transpose() * point_velocity(k, s.a); break;
       case Sensor::Type::Acceleration: v = RF.transpose() * point_acceleration(k, s.a); break;
@@ -292,12 +304,12 @@ NumericDynamics::Vector NumericDynamics::sensors(const Vector& q, const Vector& 
       case Sensor::Type::Length: {
         const V3 d = point_position(k, s.b) - point_position(k, s.a);
         const V3 vel = point_velocity(k, s.b) - point_velocity(k, s.a);
-        out.push_back(d.norm());
-        out.push_back(d.dot(vel) / d.norm());
-        continue;
+        const double sign = s.compression ? -1.0 : 1.0;
+        v = V3(sign * (d.norm() - value(s.reference)), sign * d.dot(vel) / d.norm(), 0.0);
+        break;
       }
     }
-    out.insert(out.end(), v.data(), v.data() + 3);
+    for (int c : s.components) out.push_back(v[c]);
   }
   return Eigen::Map<Vector>(out.data(), static_cast<Eigen::Index>(out.size()));
 }
@@ -306,7 +318,7 @@ NumericDynamics::State NumericDynamics::direct_dynamics(Vector q, Vector qd, con
                                                         const std::vector<int>& independent) const {
   const int n = this->n(), m = this->m();
   const std::vector<int> driven = model_.driven_joints();
-  const int load_inputs = 3 * static_cast<int>(model_.loads.size());
+  const int load_inputs = model_.load_input_count();
   Vector qdd = Vector::Zero(n);
   std::vector<bool> known(n, false);
   for (int u : independent) known[u] = true;

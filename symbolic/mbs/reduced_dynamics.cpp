@@ -35,7 +35,7 @@ void ReducedDynamics::solve(const double* u, const double* ud, const double* inp
     r.q[u_[i]] = u[i];
     r.qd[u_[i]] = ud[i];
   }
-  const int driven_at = 3 * model_.loads;
+  const int driven_at = model_.load_inputs;
   for (std::size_t i = 0; i < d_.size(); ++i) {
     r.q[d_[i]] = inputs[driven_at + 3 * i];
     r.qd[d_[i]] = inputs[driven_at + 3 * i + 1];
@@ -142,7 +142,7 @@ void ReducedDynamics::tangent(const Result& r, const double* inputs, const doubl
   Matrix dinp = Matrix::Zero(ni, nd), dp = Matrix::Zero(np, nd);
   if (dinputs && model_.inputs) dinp = Eigen::Map<const Matrix>(dinputs, model_.inputs, nd);
   if (dp_in && model_.parameters) dp = Eigen::Map<const Matrix>(dp_in, model_.parameters, nd);
-  const int driven_at = 3 * model_.loads;
+  const int driven_at = model_.load_inputs;
   for (int d = 0; d < nd; ++d) {
     for (int i = 0; i < nu; ++i) {
       dq(u_[i], d) = du ? du[d * nu + i] : 0.0;

@@ -100,7 +100,7 @@ DynamicsCase random_case(std::mt19937& rng, const GeneratedModel& g, const Vecto
   for (int i = 0; i < nu; ++i) c.u[i] += g.initial_q[g.independent[i]];
   c.inputs = random_vector(rng, g.inputs, 5.0);
   for (int i = 0; i < g.driven_count; ++i) {
-    const int at = 3 * g.loads + 3 * i;
+    const int at = g.load_inputs + 3 * i;
     c.inputs[at] = g.initial_q[g.driven[i]] + 0.1 * c.inputs[at] / 5.0;
   }
   c.p = p;

@@ -1,0 +1,268 @@
+// The sedan (generated_models/sedan.mbs.yaml) beyond the oracle comparisons every model gets in
+// test_generated.cpp: assembly from a disturbed configuration, free fall with g, the static
+// equilibrium of the design position (spring preloads and wheel loads, checked against the
+// total weight), motion ratios (generated tangent against central differences of the oracle),
+// and ride frequencies of the linearised car on linear springs and tyres.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+
+#include "generated_models/registry.hpp"
+#include "oracle_compare.hpp"
+#include "symbolic/mbs/numeric_dynamics.hpp"
+#include "symbolic/mbs/reduced_dynamics.hpp"
+
+namespace dydp::mbs {
+namespace {
+
+using namespace dydp::mbs::testing;
+
+// Spring rates the docs recommend (see docs/models.md, sedan): front chosen for ~1.2 Hz.
+constexpr double kFrontSpring = 80000.0;   // [N/m]
+constexpr double kRearSpring = 167000.0;   // [N/m] the reference's value
+constexpr double kTyre = 250000.0;         // [N/m]
+const char* const kCorners[] = {"fl", "fr", "rl", "rr"};
+
+struct Sedan {
+  const GeneratedModel& g = *generated::find_model("sedan");
+  Model model = load_model(std::string(DYDP_MODELS_DIR) + "/sedan.mbs.yaml");
+  ReducedDynamics reduced{g};
+  Vector q0 = Eigen::Map<const Vector>(g.initial_q, g.n);
+
+  int input(const std::string& name) const {
+    for (int i = 0; i < g.inputs; ++i)
+      if (name == g.input_names[i]) return i;
+    ADD_FAILURE() << "no input " << name;
+    return 0;
+  }
+  int sensor(const std::string& name) const {
+    for (int i = 0; i < g.sensor_outputs; ++i)
+      if (name == g.sensor_names[i]) return i;
+    ADD_FAILURE() << "no sensor output " << name;
+    return 0;
+  }
+  int coordinate(const std::string& name) const {
+    for (int i = 0; i < g.n; ++i)
+      if (name == g.coordinate_names[i]) return i;
+    ADD_FAILURE() << "no coordinate " << name;
+    return 0;
+  }
+  Vector u_of(const Vector& q) const {
+    Vector u(reduced.nu());
+    for (int i = 0; i < reduced.nu(); ++i) u[i] = q[reduced.independent()[i]];
+    return u;
+  }
+  Vector sensors(const ReducedDynamics::Result& r, const Vector& inputs) const {
+    Vector out(g.sensor_outputs), lam = Vector::Zero(std::max(1, g.m)), in = inputs;
+    g.sensors(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), in.data(), g.parameter_values, out.data());
+    return out;
+  }
+  double total_mass() const {
+    double m = 0.0;
+    for (const Body& b : model.bodies) m += model.value(b.mass);
+    return m;
+  }
+};
+
+TEST(Sedan, Structure) {
+  Sedan s;
+  EXPECT_EQ(s.g.n, 33);
+  EXPECT_EQ(s.g.m, 18);
+  EXPECT_EQ(s.reduced.nu(), 14);
+  EXPECT_EQ(s.g.driven_count, 1);
+  // the design position closes every loop exactly
+  NumericDynamics oracle(s.model);
+  EXPECT_LT(oracle.constraints(s.q0).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+TEST(Sedan, AssemblesFromADisturbedConfiguration) {
+  Sedan s;
+  NumericDynamics oracle(s.model);
+  const Vector inputs = Vector::Zero(s.g.inputs);
+  for (double rack : {0.0, 0.05, -0.07}) {
+    Vector in = inputs;
+    in[s.input("rack.q")] = rack;
+    // wheel travel (arms), body attitude, and a guess of the dependent coordinates 0.05 rad off
+    Vector u = s.u_of(s.q0);
+    u[6] = 0.04;
+    u[7] = -0.03;
+    u[8] = 0.05;
+    u[9] = -0.02;
+    u[4] = 0.02;
+    u[5] = -0.03;
+    Vector guess = s.q0;
+    for (int v : s.reduced.dependent()) guess[v] += 0.05;
+    const Vector ud = Vector::Zero(s.reduced.nu());
+    ReducedDynamics::Result r;
+    s.reduced.solve(u.data(), ud.data(), in.data(), nullptr, guess, r);
+    EXPECT_LE(r.newton_iterations, 8) << "rack " << rack;
+    EXPECT_LT(oracle.constraints(r.q).cwiseAbs().maxCoeff(), 1e-12) << "rack " << rack;
+    EXPECT_NEAR(r.q[s.coordinate("rack")], rack, 1e-15);
+  }
+}
+
+TEST(Sedan, FallsFreelyWithG) {
+  Sedan s;
+  NumericDynamics oracle(s.model);
+  const Vector in = Vector::Zero(s.g.inputs);
+  const Vector u = s.u_of(s.q0), ud = Vector::Zero(s.reduced.nu());
+  ReducedDynamics::Result r;
+  s.reduced.solve(u.data(), ud.data(), in.data(), nullptr, s.q0, r);
+  // every coordinate but the chassis height keeps still; no cut transmits a force
+  for (int j = 0; j < s.g.n; ++j)
+    EXPECT_NEAR(r.qdd[j], j == s.coordinate("z") ? -9.81 : 0.0, 1e-10) << s.g.coordinate_names[j];
+  EXPECT_LT(r.lam.cwiseAbs().maxCoeff(), 1e-9);
+  // every body's centre of mass (the oracle's kinematics) accelerates with g
+  const NumericDynamics::Kinematics k = oracle.kinematics(r.q, r.qd, r.qdd);
+  for (std::size_t b = 1; b < s.model.bodies.size(); ++b) {
+    const int f = s.model.bodies[b].frame;
+    const Eigen::Vector3d com(s.model.value(s.model.bodies[b].com[0]), s.model.value(s.model.bodies[b].com[1]),
+                              s.model.value(s.model.bodies[b].com[2]));
+    const Eigen::Vector3d a = k.acceleration[f] + k.alpha[f].cross(k.rotation[f] * com);
+    EXPECT_LT((a - Eigen::Vector3d(0, 0, -9.81)).norm(), 1e-10) << s.model.bodies[b].name;
+  }
+}
+
+// Static equilibrium of the design position under gravity, symmetric: spring forces (front,
+// rear) and vertical tyre loads (front, rear) with B^T c(inputs) = 0 for the independent
+// coordinates (linear in the inputs).
+struct Equilibrium {
+  double spring_front, spring_rear, tyre_front, tyre_rear, residual;
+};
+
+Equilibrium static_equilibrium(const Sedan& s) {
+  const Vector u = s.u_of(s.q0), ud = Vector::Zero(s.reduced.nu());
+  auto reduced_force = [&](const Vector& in) {
+    ReducedDynamics::Result r;
+    s.reduced.solve(u.data(), ud.data(), in.data(), nullptr, s.q0, r);
+    return Vector(r.reduced.matrixL() * (r.reduced.matrixL().transpose() * r.udd));  // B^T M B udd
+  };
+  const Vector zero = Vector::Zero(s.g.inputs);
+  const Vector f0 = reduced_force(zero);
+  const std::vector<std::vector<std::string>> unknowns{{"spring_fl", "spring_fr"}, {"spring_rl", "spring_rr"},
+                                                       {"tyre_fz_fl.z", "tyre_fz_fr.z"}, {"tyre_fz_rl.z", "tyre_fz_rr.z"}};
+  Matrix G(f0.size(), 4);
+  for (int k = 0; k < 4; ++k) {
+    Vector in = zero;
+    for (const auto& name : unknowns[k]) in[s.input(name)] = 1.0;
+    G.col(k) = reduced_force(in) - f0;
+  }
+  const Vector x = G.colPivHouseholderQr().solve(-f0);
+  return {x[0], x[1], x[2], x[3], (G * x + f0).cwiseAbs().maxCoeff() / f0.cwiseAbs().maxCoeff()};
+}
+
+TEST(Sedan, StaticEquilibriumCarriesTheWeight) {
+  Sedan s;
+  const Equilibrium e = static_equilibrium(s);
+  std::printf("static: spring preload front %.1f N, rear %.1f N; wheel load front %.1f N, rear %.1f N\n",
+              e.spring_front, e.spring_rear, e.tyre_front, e.tyre_rear);
+  RecordProperty("spring_preload_front", std::to_string(e.spring_front));
+  RecordProperty("spring_preload_rear", std::to_string(e.spring_rear));
+  RecordProperty("wheel_load_front", std::to_string(e.tyre_front));
+  RecordProperty("wheel_load_rear", std::to_string(e.tyre_rear));
+  EXPECT_LT(e.residual, 1e-10) << "4 forces balance all 14 independent coordinates";
+  EXPECT_NEAR(2 * (e.tyre_front + e.tyre_rear), 9.81 * s.total_mass(), 1e-8 * s.total_mass());
+  EXPECT_GT(e.spring_front, 0.0);
+  EXPECT_GT(e.spring_rear, 0.0);
+}
+
+// Motion ratio d(spring compression)/d(wheel-centre height) per corner by the generated
+// tangents (through the partitioning), against central differences of the oracle.
+TEST(Sedan, MotionRatiosMatchTheOracle) {
+  Sedan s;
+  NumericDynamics oracle(s.model);
+  const Vector u0 = s.u_of(s.q0), ud = Vector::Zero(s.reduced.nu()), in = Vector::Zero(s.g.inputs);
+  ReducedDynamics::Result r;
+  s.reduced.solve(u0.data(), ud.data(), in.data(), nullptr, s.q0, r);
+  const int arm_u[4] = {6, 7, 8, 9};
+  for (int c = 0; c < 4; ++c) {
+    const std::string corner = kCorners[c];
+    Matrix du = Matrix::Zero(s.reduced.nu(), 1), dq, dqd, dqdd;
+    du(arm_u[c], 0) = 1.0;
+    s.reduced.tangent(r, in.data(), nullptr, 1, du.data(), nullptr, nullptr, nullptr, dq, dqd, dqdd);
+    std::vector<double> out(s.g.sensor_outputs), dout(s.g.sensor_outputs);
+    const Vector lam = Vector::Zero(s.g.m), zq = Vector::Zero(s.g.n), zin = Vector::Zero(s.g.inputs),
+                 zp = Vector::Zero(s.g.parameters);
+    s.g.sensors_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), in.data(), s.g.parameter_values, 1,
+                        dq.data(), zq.data(), zq.data(), zin.data(), zp.data(), out.data(), dout.data());
+    const double ratio = dout[s.sensor("spring_defl_" + corner + ".length")] / dout[s.sensor("wheel_z_" + corner + ".z")];
+    // the oracle: central differences of spring length and wheel height along the arm coordinate
+    auto at = [&](double h) {
+      Vector q = r.q, qd = Vector::Zero(s.g.n);
+      q[s.reduced.independent()[arm_u[c]]] += h;
+      std::vector<int> u(s.reduced.independent());
+      const NumericDynamics::State st = oracle.direct_dynamics(q, qd, in, u);
+      return oracle.sensors(st.q, st.qd, Vector::Zero(s.g.n));
+    };
+    const double h = 1e-5;
+    const Vector d = (at(h) - at(-h)) / (2 * h);
+    const double oracle_ratio = d[s.sensor("spring_defl_" + corner + ".length")] / d[s.sensor("wheel_z_" + corner + ".z")];
+    std::printf("motion ratio %s: %.6f (oracle %.6f)\n", corner.c_str(), ratio, oracle_ratio);
+    RecordProperty("motion_ratio_" + corner, std::to_string(ratio));
+    EXPECT_NEAR(ratio, oracle_ratio, 1e-7);
+    EXPECT_GT(ratio, 0.3);
+    EXPECT_LT(ratio, 1.0);
+  }
+}
+
+// The car on linear springs (preloaded for the design position) and linear tyres on a flat
+// road: udd(u) linearised at the design position by central differences, K = -d(udd)/du;
+// the eigenvalues of K are the squared circular frequencies of the undamped modes.
+TEST(Sedan, RideFrequencies) {
+  Sedan s;
+  const Equilibrium e = static_equilibrium(s);
+  const int nu = s.reduced.nu();
+  const Vector u0 = s.u_of(s.q0), ud = Vector::Zero(nu);
+  ReducedDynamics::Result r0;
+  const Vector no_inputs = Vector::Zero(s.g.inputs);
+  s.reduced.solve(u0.data(), ud.data(), no_inputs.data(), nullptr, s.q0, r0);
+  const Vector sensors0 = s.sensors(r0, no_inputs);
+  auto udd = [&](const Vector& u) {
+    ReducedDynamics::Result r;
+    Vector in = Vector::Zero(s.g.inputs);
+    s.reduced.solve(u.data(), ud.data(), in.data(), nullptr, s.q0, r);
+    const Vector y = s.sensors(r, in);
+    for (const char* c : kCorners) {
+      const std::string corner = c;
+      const bool front = corner[0] == 'f';
+      const double deflection = y[s.sensor("spring_defl_" + corner + ".length")];
+      in[s.input("spring_" + corner)] = (front ? e.spring_front : e.spring_rear) +
+                                        (front ? kFrontSpring : kRearSpring) * deflection;
+      const double sink = sensors0[s.sensor("wheel_z_" + corner + ".z")] - y[s.sensor("wheel_z_" + corner + ".z")];
+      in[s.input("tyre_fz_" + corner + ".z")] = (front ? e.tyre_front : e.tyre_rear) + kTyre * sink;
+    }
+    s.reduced.solve(u.data(), ud.data(), in.data(), nullptr, s.q0, r);
+    return Vector(r.udd);
+  };
+  EXPECT_LT(udd(u0).cwiseAbs().maxCoeff(), 1e-8) << "the design position is an equilibrium";
+  Matrix K(nu, nu);
+  const double h = 1e-6;
+  for (int i = 0; i < nu; ++i) {
+    Vector up = u0, um = u0;
+    up[i] += h;
+    um[i] -= h;
+    K.col(i) = -(udd(up) - udd(um)) / (2 * h);
+  }
+  Eigen::EigenSolver<Matrix> eig(K);
+  std::vector<double> hz;
+  for (int i = 0; i < nu; ++i) {
+    const double lambda = eig.eigenvalues()[i].real();
+    if (lambda > 1.0) hz.push_back(std::sqrt(lambda) / (2 * std::numbers::pi));
+  }
+  std::sort(hz.begin(), hz.end());
+  std::string list;
+  for (double f : hz) list += std::to_string(f) + " ";
+  std::printf("undamped frequencies [Hz]: %s\n", list.c_str());
+  RecordProperty("frequencies_hz", list);
+  ASSERT_EQ(hz.size(), 7u) << "bounce, pitch, roll and four wheel-hop modes (x, y, yaw and spins are free)";
+  // bounce and pitch (coupled front and rear ride) below 2.5 Hz, wheel hop above 8 Hz
+  EXPECT_GT(hz[0], 0.9);
+  EXPECT_LT(hz[1], 2.5);
+  EXPECT_GT(hz[3], 8.0);
+}
+
+}  // namespace
+}  // namespace dydp::mbs
