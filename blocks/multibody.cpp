@@ -2,7 +2,10 @@
 // coordinates u and velocities u_dot; dependent coordinates are solved by Newton-Raphson on the
 // generated constraints at every evaluation. Inputs: one port per load of the model (force or
 // torque in the load's declared frame, width 3 or the components declared; link force, width 1)
-// and per driven joint three scalar ports NAME, NAME_rate, NAME_acc (q, qd, qdd). Outputs:
+// and per driven joint three scalar ports NAME, NAME_rate, NAME_acc (the commanded q, qd, qdd).
+// A driven joint follows its command through a stiff critically damped servo (two states,
+// r'' = acc + w^2 (q - r) + 2 w (rate - r'), w = 2 pi 30 Hz): positions and velocities then
+// read states only, so feedback through tyres or springs is no algebraic loop. Outputs:
 // q, qd, qdd (all coordinates, model order) and one port per sensor. Tangents go through the
 // generated tangent functions and the partitioning's tangent (ReducedDynamics::tangent).
 //
@@ -31,6 +34,7 @@ using Vector = Eigen::VectorXd;
 using Matrix = Eigen::MatrixXd;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kServoOmega = 2.0 * 3.14159265358979323846 * 30.0;  // [rad/s] driven-joint servo
 
 class Multibody : public Block {
  public:
@@ -45,15 +49,18 @@ class Multibody : public Block {
       declare_input(joint + "_rate", 1, "m/s or rad/s");
       declare_input(joint + "_acc", 1, "m/s^2 or rad/s^2");
     }
-    const bool driven = g_.driven_count > 0;
-    declare_output("q", g_.n, "m or rad", driven);
-    declare_output("qd", g_.n, "m/s or rad/s", driven);
+    declare_output("q", g_.n, "m or rad", false);
+    declare_output("qd", g_.n, "m/s or rad/s", false);
     declare_output("qdd", g_.n, "m/s^2 or rad/s^2", true);
     for (int s = 0; s < g_.sensor_count; ++s)
-      declare_output(g_.sensor_ports[s], g_.sensor_widths[s], "", driven || g_.sensor_reads_acceleration[s]);
+      declare_output(g_.sensor_ports[s], g_.sensor_widths[s], "", g_.sensor_reads_acceleration[s]);
     std::vector<std::string> states;
     for (int j : reduced_.independent()) states.push_back(std::string("q.") + g_.coordinate_names[j]);
     for (int j : reduced_.independent()) states.push_back(std::string("qd.") + g_.coordinate_names[j]);
+    for (int i = 0; i < g_.driven_count; ++i) {
+      states.push_back(std::string("q.") + g_.coordinate_names[g_.driven[i]]);
+      states.push_back(std::string("qd.") + g_.coordinate_names[g_.driven[i]]);
+    }
     declare_states(states);
   }
 
@@ -70,11 +77,17 @@ class Multibody : public Block {
       x0[i] = exposed_ ? e.p[g_.parameters + i] : g_.initial_q[reduced_.independent()[i]];
       x0[nu + i] = exposed_ ? e.p[g_.parameters + nu + i] : 0.0;
     }
+    for (int i = 0; i < g_.driven_count; ++i) {
+      x0[2 * nu + 2 * i] = g_.initial_q[g_.driven[i]];
+      x0[2 * nu + 2 * i + 1] = 0.0;
+    }
   }
   void initial_state_tangent(const Eval&, const Seeds& s, DirView dx0) const override {
     const int nu = reduced_.nu();
-    for (int d = 0; d < s.directions; ++d)
+    for (int d = 0; d < s.directions; ++d) {
       for (int i = 0; i < 2 * nu; ++i) dx0(i, d) = exposed_ ? s.p(g_.parameters + i, d) : 0.0;
+      for (int i = 2 * nu; i < 2 * nu + 2 * g_.driven_count; ++i) dx0(i, d) = 0.0;
+    }
   }
 
   void outputs(const Eval& e, double* const* y) const override {
@@ -129,6 +142,10 @@ class Multibody : public Block {
       xdot[i] = e.x[nu + i];
       xdot[nu + i] = r.udd[i];
     }
+    for (int i = 0; i < g_.driven_count; ++i) {
+      xdot[2 * nu + 2 * i] = e.x[2 * nu + 2 * i + 1];
+      xdot[2 * nu + 2 * i + 1] = r.qdd[g_.driven[i]];
+    }
   }
 
   void derivatives_tangent(const Eval& e, const Seeds& s, DirView dxdot) const override {
@@ -136,34 +153,49 @@ class Multibody : public Block {
     Matrix dq, dqd, dqdd, dinp, dp;
     tangent(e, s, r, dq, dqd, dqdd, dinp, dp);
     const int nu = reduced_.nu();
-    for (int d = 0; d < s.directions; ++d)
+    for (int d = 0; d < s.directions; ++d) {
       for (int i = 0; i < nu; ++i) {
         dxdot(i, d) = s.x(nu + i, d);
         dxdot(nu + i, d) = dqdd(reduced_.independent()[i], d);
       }
+      for (int i = 0; i < g_.driven_count; ++i) {
+        dxdot(2 * nu + 2 * i, d) = s.x(2 * nu + 2 * i + 1, d);
+        dxdot(2 * nu + 2 * i + 1, d) = dqdd(g_.driven[i], d);
+      }
+    }
   }
 
  private:
-  // Input ports: the loads (their widths), then q, qd, qdd of each driven joint (width 1 each).
-  int ports() const { return g_.loads + 3 * g_.driven_count; }
-  int port_width(int k) const { return k < g_.loads ? g_.load_widths[k] : 1; }
-
   Vector padded(const Vector& v) const { return v.size() ? v : Vector::Zero(1); }
 
   const double* parameters(const Eval& e) const {
     return exposed_ && g_.parameters ? e.p : (g_.parameters ? g_.parameter_values : zero_);
   }
 
+  // The model's input array: load components from the ports, then q, qd, qdd of each driven
+  // joint from its servo states (qdd, the servo law, only once the inputs are ready).
   Vector inputs(const Eval& e) const {
     Vector in = Vector::Zero(std::max(1, g_.inputs));
-    if (!e.inputs_ready) {
-      // driven motions are needed by every output when the model has any (then all feed through)
-      return in;
+    const int nu = reduced_.nu();
+    for (int i = 0; i < g_.driven_count; ++i) {
+      in[g_.load_inputs + 3 * i] = e.x[2 * nu + 2 * i];
+      in[g_.load_inputs + 3 * i + 1] = e.x[2 * nu + 2 * i + 1];
     }
-    int at = 0;
-    for (int k = 0; k < ports(); ++k)
-      for (int i = 0; i < port_width(k); ++i) in[at++] = e.u[k][i];
+    if (!e.inputs_ready) return in;
+    for (int k = 0; k < g_.loads; ++k)
+      for (int i = 0, at = load_offset(k); i < g_.load_widths[k]; ++i) in[at + i] = e.u[k][i];
+    for (int i = 0; i < g_.driven_count; ++i) {
+      const int port = g_.loads + 3 * i;
+      in[g_.load_inputs + 3 * i + 2] = e.u[port + 2][0] +
+                                       kServoOmega * kServoOmega * (e.u[port][0] - e.x[2 * nu + 2 * i]) +
+                                       2.0 * kServoOmega * (e.u[port + 1][0] - e.x[2 * nu + 2 * i + 1]);
+    }
     return in;
+  }
+  int load_offset(int k) const {
+    int at = 0;
+    for (int i = 0; i < k; ++i) at += g_.load_widths[i];
+    return at;
   }
 
   // The partitioned dynamics at (x, inputs, p); the last result is reused for the same point.
@@ -208,11 +240,17 @@ class Multibody : public Block {
         du(i, d) = s.x(i, d);
         dud(i, d) = s.x(nu + i, d);
       }
-      if (e.inputs_ready) {
-        int at = 0;
-        for (int k = 0; k < ports(); ++k)
-          for (int i = 0; i < port_width(k); ++i) dinp(at++, d) = s.u[k](i, d);
+      for (int i = 0; i < g_.driven_count; ++i) {
+        const int at = g_.load_inputs + 3 * i, port = g_.loads + 3 * i;
+        dinp(at, d) = s.x(2 * nu + 2 * i, d);
+        dinp(at + 1, d) = s.x(2 * nu + 2 * i + 1, d);
+        if (e.inputs_ready)
+          dinp(at + 2, d) = s.u[port + 2](0, d) + kServoOmega * kServoOmega * (s.u[port](0, d) - s.x(2 * nu + 2 * i, d)) +
+                            2.0 * kServoOmega * (s.u[port + 1](0, d) - s.x(2 * nu + 2 * i + 1, d));
       }
+      if (e.inputs_ready)
+        for (int k = 0; k < g_.loads; ++k)
+          for (int i = 0, at = load_offset(k); i < g_.load_widths[k]; ++i) dinp(at + i, d) = s.u[k](i, d);
       if (exposed_)
         for (int i = 0; i < g_.parameters; ++i) dp(i, d) = s.p(i, d);
     }

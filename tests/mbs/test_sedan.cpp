@@ -2,14 +2,21 @@
 // test_generated.cpp: assembly from a disturbed configuration, free fall with g, the static
 // equilibrium of the design position (spring preloads and wheel loads, checked against the
 // total weight), motion ratios (generated tangent against central differences of the oracle),
-// and ride frequencies of the linearised car on linear springs and tyres.
+// and ride frequencies of the linearised car on linear springs and tyres; the multibody.sedan
+// block at rest in a scene with the spring, damper and tyre blocks.
 #include <gtest/gtest.h>
+
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <numbers>
+#include <sstream>
 #include <string>
 
+#include "engine/diagram.hpp"
+#include "engine/run.hpp"
 #include "generated_models/registry.hpp"
 #include "oracle_compare.hpp"
 #include "symbolic/mbs/numeric_dynamics.hpp"
@@ -262,6 +269,57 @@ TEST(Sedan, RideFrequencies) {
   EXPECT_GT(hz[0], 0.9);
   EXPECT_LT(hz[1], 2.5);
   EXPECT_GT(hz[3], 8.0);
+}
+
+
+// The multibody.sedan block in a scene: linear springs preloaded for the design position,
+// linear dampers (math.gain on the stroke rate, tension positive), tyre.vertical on a flat road
+// at z = 0, rack held by its servo at 0. Dropped from 1 cm above the design position, the car
+// settles back into it (its static equilibrium); every feedback path (springs, dampers, tyres)
+// runs through states, so the scene has no algebraic loop.
+TEST(SedanScene, RestsInItsDesignPosition) {
+  Sedan s;
+  const Equilibrium e = static_equilibrium(s);
+  std::ostringstream y;
+  y << "scene: sedan_rest\ntime: {start: 0.0, stop: 3.0, output_step: 0.1}\n"
+    << "solver: {method: bdf, rtol: 1.0e-8, atol: 1.0e-10}\nblocks:\n"
+    << "  car: {type: multibody.sedan, q0.z: " << s.q0[2] + 0.01 << "}\n  zero: {type: source.constant, value: 0.0}\n";
+  for (const char* c : kCorners) {
+    const bool front = c[0] == 'f';
+    y << "  spring_" << c << ": {type: spring.linear, stiffness: " << (front ? kFrontSpring : kRearSpring)
+      << ", preload: " << (front ? e.spring_front : e.spring_rear) << "}\n"
+      << "  damper_" << c << ": {type: math.gain, k: 8000.0}\n"
+      << "  tyre_" << c << ": {type: tyre.vertical}\n";
+  }
+  y << "connections:\n";
+  for (const char* c : kCorners) {
+    const std::string k = c;
+    for (const std::string& line :
+         {"car.spring_defl_" + k + " -> spring_" + k + ".deflection", "spring_" + k + ".force -> car.spring_" + k,
+          "car.damper_rate_" + k + " -> damper_" + k + ".u", "damper_" + k + ".y -> car.damper_" + k,
+          "zero.y -> tyre_" + k + ".road_z", "zero.y -> tyre_" + k + ".road_zdot",
+          "car.wheel_z_" + k + " -> tyre_" + k + ".wheel_z", "car.wheel_zdot_" + k + " -> tyre_" + k + ".wheel_zdot",
+          "tyre_" + k + ".force -> car.tyre_fz_" + k, "zero.y -> car.arb_" + k, "zero.y -> car.tyre_fx_" + k,
+          "zero.y -> car.tyre_fy_" + k, "zero.y -> car.wheel_torque_" + k})
+      y << "  - " << line << "\n";
+  }
+  y << "  - zero.y -> car.rack\n  - zero.y -> car.rack_rate\n  - zero.y -> car.rack_acc\n"
+    << "outputs: [car.body_pos, car.roll, car.pitch, car.wheel_z_fl, car.body_acc_z]\n";
+  const std::string path = ::testing::TempDir() + "sedan_rest_" + std::to_string(::getpid()) + ".yaml";
+  std::ofstream(path) << y.str();
+  engine::RunOptions options;
+  options.sensitivities = false;
+  const engine::RunResult r = engine::run(engine::load_scene(path), options);
+  std::remove(path.c_str());
+  const int last = static_cast<int>(r.t.size()) - 1;
+  ASSERT_NEAR(r.t.back(), 3.0, 1e-12);
+  EXPECT_GT(r.value(0, r.signal_index("car.body_pos[2]")), s.q0[2] + 0.2 + 0.009);
+  // tyre deflection at the design wheel loads: the design wheel-centre height
+  EXPECT_NEAR(r.value(last, r.signal_index("car.wheel_z_fl")), 0.32 - e.tyre_front / kTyre, 2e-5);
+  EXPECT_NEAR(r.value(last, r.signal_index("car.body_pos[2]")), s.q0[2] + 0.2, 5e-5);
+  EXPECT_NEAR(r.value(last, r.signal_index("car.roll")), 0.0, 1e-9);
+  EXPECT_NEAR(r.value(last, r.signal_index("car.pitch")), s.q0[4], 2e-4);
+  EXPECT_LT(std::abs(r.value(last, r.signal_index("car.body_acc_z"))), 1e-3);
 }
 
 }  // namespace
