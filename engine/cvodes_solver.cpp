@@ -275,6 +275,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
     CVodeGetNumRhsEvals(S.mem, &v), st.rhs_evals += v;
     CVodeGetNumErrTestFails(S.mem, &v), st.error_test_failures += v;
     CVodeGetNumNonlinSolvIters(S.mem, &v), st.nonlinear_iterations += v;
+    CVodeGetNumNonlinSolvConvFails(S.mem, &v), st.nonlinear_failures += v;
     if (bdf) CVodeGetNumJacEvals(S.mem, &v), st.jac_evals += v;
   };
 

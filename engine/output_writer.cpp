@@ -82,6 +82,7 @@ std::string run_json(const Diagram& d, const RunResult& r) {
       {"jacobian_evaluations", s.jac_evals},
       {"error_test_failures", s.error_test_failures},
       {"nonlinear_iterations", s.nonlinear_iterations},
+      {"nonlinear_failures", s.nonlinear_failures},
       {"cpu_seconds", s.cpu_seconds},
       {"simulated_seconds", s.simulated_seconds},
       {"realtime_factor", s.realtime_factor},

@@ -32,6 +32,7 @@ struct RunStats {
   long jac_evals = 0;             ///< Jacobians (each one tangent pass over all states)
   long error_test_failures = 0;
   long nonlinear_iterations = 0;
+  long nonlinear_failures = 0;    ///< corrector convergence failures (step retried smaller)
   double cpu_seconds = 0.0;
   double simulated_seconds = 0.0;
   double realtime_factor = 0.0;   ///< simulated seconds per CPU second
