@@ -111,10 +111,14 @@ void ReducedDynamics::solve(const double* u, const double* ud, const double* inp
   }
   Vector cf(nf);
   for (int a = 0; a < nf; ++a) cf[a] = c[f_[a]];
-  r.reduced.compute(r.B.transpose() * Mff * r.B);
+  // a tree (no constraints, u in coordinate order): B = I, and the products would cost two
+  // dense n^3 products
+  const bool identity = m == 0 && u_ == f_;
+  if (identity) r.reduced.compute(Mff);
+  else r.reduced.compute(r.B.transpose() * Mff * r.B);
   if (r.reduced.info() != Eigen::Success)
     throw std::runtime_error(std::string(model_.name) + ": reduced mass matrix is not positive definite");
-  r.udd = r.reduced.solve(-(r.B.transpose() * (cf + Mff * beta)));
+  r.udd = identity ? Vector(r.reduced.solve(-cf)) : Vector(r.reduced.solve(-(r.B.transpose() * (cf + Mff * beta))));
   const Vector qddf = r.B * r.udd + beta;
   for (int a = 0; a < nf; ++a) r.qdd[f_[a]] = qddf[a];
 
@@ -186,7 +190,7 @@ void ReducedDynamics::tangent(const Result& r, const double* inputs, const doubl
     drf.row(a) = dout.row(f_[a]);
     for (int b = 0; b < nf; ++b) Mff(a, b) = r.M(f_[a], f_[b]);
   }
-  const Matrix dudd = r.reduced.solve(-(r.B.transpose() * (drf + Mff * dbeta)));
+  const Matrix dudd = m == 0 && u_ == f_ ? Matrix(r.reduced.solve(-drf)) : Matrix(r.reduced.solve(-(r.B.transpose() * (drf + Mff * dbeta))));
   const Matrix dqddf = r.B * dudd + dbeta;
   for (int a = 0; a < nf; ++a) dqdd.row(f_[a]) = dqddf.row(a);
 }
