@@ -7,6 +7,7 @@
 #include <random>
 #include <string>
 
+#include "blocks/time_series.hpp"
 #include "engine/registry.hpp"
 
 namespace dydp::blocks {
@@ -42,10 +43,14 @@ int positive_integer(const BlockSettings& s, const char* name) {
 
 /// z_i = A_i sin(2 pi f_i t + phi_i) + a sum_k sin(2 pi f_k t + theta_ik), a = noise_rms sqrt(2 / N),
 /// f_k = f_lo + (k + 1/2)(f_hi - f_lo) / N: a noise of the given rms spread evenly over the band.
+/// With `input_file` set (dydp replay), the pads instead follow the recorded columns named in
+/// `pad_columns`, by cubic Hermite interpolation (displacement and rate continuous); recorded
+/// data has no parameters, so the tangents are zero.
 class FourPoster : public Block {
  public:
   enum { kNoiseRms = 12, kNoiseLow, kNoiseHigh };
-  FourPoster(unsigned long long seed, int components) : components_(components) {
+  FourPoster(unsigned long long seed, int components, std::vector<TimeSeries> recorded)
+      : components_(components), recorded_(std::move(recorded)) {
     for (int pad = 0; pad < 4; ++pad) phases_[pad] = random_phases(seed + 7919ull * pad, components);
     declare_output("z", 4, "m");
     declare_output("zdot", 4, "m/s");
@@ -58,6 +63,10 @@ class FourPoster : public Block {
   }
 
   void outputs(const Eval& e, double* const* y) const override {
+    if (!recorded_.empty()) {
+      for (int pad = 0; pad < 4; ++pad) recorded_[pad].cubic(e.t, y[0][pad], y[1][pad]);
+      return;
+    }
     const double* p = e.p;
     const double a = p[kNoiseRms] * std::sqrt(2.0 / components_);
     for (int pad = 0; pad < 4; ++pad) {
@@ -75,6 +84,11 @@ class FourPoster : public Block {
     }
   }
   void outputs_tangent(const Eval& e, const Seeds& s, const DirView* dy) const override {
+    if (!recorded_.empty()) {
+      for (int d = 0; d < s.directions; ++d)
+        for (int pad = 0; pad < 4; ++pad) dy[0](pad, d) = dy[1](pad, d) = 0.0;
+      return;
+    }
     const double* p = e.p;
     const double noise_shape = std::sqrt(2.0 / components_);
     for (int pad = 0; pad < 4; ++pad) {
@@ -100,6 +114,7 @@ class FourPoster : public Block {
  private:
   int components_;
   std::vector<double> phases_[4];
+  std::vector<TimeSeries> recorded_;
 };
 
 std::vector<ParamSpec> fourposter_params() {
@@ -122,10 +137,19 @@ const engine::BlockRegistration fourposter({
     "4-poster rig: per pad a sine plus a smooth seeded noise (sum of random-phase sines). Pads fl, fr, rl, rr.",
     fourposter_params(),
     {{"seed", "seed of the noise phases", "1", false},
-     {"components", "number of sines in each pad's noise", "50", false}},
+     {"components", "number of sines in each pad's noise", "50", false},
+     {"input_file", "recorded pad displacements (CSV: t and one column per pad); replaces the sines", "", false},
+     {"pad_columns", "columns of input_file for the pads fl, fr, rl, rr", "", false}},
     [](const BlockSettings& s) -> std::unique_ptr<Block> {
+      std::vector<TimeSeries> recorded;
+      if (!s.text("input_file").empty()) {
+        std::vector<std::string> columns = s.texts("pad_columns");
+        if (columns.size() == 1 && columns[0].empty()) columns = {kPads[0], kPads[1], kPads[2], kPads[3]};
+        if (columns.size() != 4) s.fail("pad_columns", "expected four column names (fl, fr, rl, rr)");
+        recorded = read_time_series(s, "input_file", "t", columns, "pad_columns");
+      }
       return std::make_unique<FourPoster>(static_cast<unsigned long long>(s.integer("seed")),
-                                          positive_integer(s, "components"));
+                                          positive_integer(s, "components"), std::move(recorded));
     }});
 
 // ---------------------------------------------------------------- road.iso8608

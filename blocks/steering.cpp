@@ -3,11 +3,10 @@
 // law is a breakpoint, and branches are chosen with Eval::reached().
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <numbers>
-#include <sstream>
 
+#include "blocks/time_series.hpp"
 #include "engine/errors.hpp"
 #include "engine/registry.hpp"
 
@@ -103,40 +102,9 @@ class Steering : public Block {
 
 /// Reads (time, value) columns of a CSV file for mode csv.
 void read_table(const BlockSettings& s, std::vector<double>& t, std::vector<double>& y) {
-  const std::string file = s.path("file");
-  std::ifstream in(file);
-  if (!in) s.fail("file", "cannot open '" + file + "'");
-  const auto split = [](const std::string& line) {
-    std::vector<std::string> cells;
-    std::stringstream ss(line);
-    std::string cell;
-    while (std::getline(ss, cell, ',')) {
-      const auto b = cell.find_first_not_of(" \t\r"), e = cell.find_last_not_of(" \t\r");
-      cells.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
-    }
-    return cells;
-  };
-  std::string line;
-  if (!std::getline(in, line)) throw engine::InputError(file, 1, "", "empty CSV file");
-  const auto header = split(line);
-  const auto column = [&](const char* key) {
-    const std::string name = s.text(key);
-    const auto it = std::find(header.begin(), header.end(), name);
-    if (it == header.end()) s.fail(key, "no column '" + name + "' in " + file);
-    return static_cast<size_t>(it - header.begin());
-  };
-  const size_t ct = column("time_column"), cy = column("column");
-  for (int row = 2; std::getline(in, line); ++row) {
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    const auto cells = split(line);
-    double tv = 0, yv = 0;
-    if (cells.size() <= std::max(ct, cy) || !engine::parse_number(cells[ct], tv) || !engine::parse_number(cells[cy], yv))
-      throw engine::InputError(file, row, s.text("column"), "malformed row");
-    if (!t.empty() && !(tv > t.back())) throw engine::InputError(file, row, s.text("time_column"), "times must increase");
-    t.push_back(tv);
-    y.push_back(yv);
-  }
-  if (t.size() < 2) throw engine::InputError(file, 2, s.text("column"), "the table needs at least two rows");
+  const TimeSeries series = read_time_series(s, "file", s.text("time_column"), {s.text("column")}, "column").front();
+  t = series.times();
+  y = series.values();
 }
 
 const engine::BlockRegistration steering({

@@ -12,47 +12,13 @@
 #include <thread>
 
 #include "apps/dydp/commands.hpp"
+#include "engine/csv.hpp"
 #include "engine/errors.hpp"
 #include "engine/output_writer.hpp"
 #include "engine/run.hpp"
 
 namespace dydp::apps {
 namespace {
-
-/// The columns of a CSV file with a header line: name -> values.
-struct Csv {
-  std::vector<std::string> names;
-  std::vector<std::vector<double>> columns;
-};
-
-Csv read_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw engine::InputError(path, 0, "--input", "cannot open the recorded input");
-  Csv csv;
-  std::string line;
-  std::getline(in, line);
-  std::stringstream header(line);
-  for (std::string cell; std::getline(header, cell, ',');) {
-    cell.erase(0, cell.find_first_not_of(" \t\r"));
-    cell.erase(cell.find_last_not_of(" \t\r") + 1);
-    csv.names.push_back(cell);
-  }
-  csv.columns.resize(csv.names.size());
-  for (int row = 2; std::getline(in, line); ++row) {
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    std::stringstream ss(line);
-    size_t c = 0;
-    for (std::string cell; std::getline(ss, cell, ','); ++c) {
-      double v = 0;
-      cell.erase(cell.find_last_not_of(" \t\r") + 1);
-      if (c >= csv.names.size() || !engine::parse_number(cell, v))
-        throw engine::InputError(path, row, c < csv.names.size() ? csv.names[c] : "", "malformed value '" + cell + "'");
-      csv.columns[c].push_back(v);
-    }
-    if (c != csv.names.size()) throw engine::InputError(path, row, "", "expected " + std::to_string(csv.names.size()) + " values");
-  }
-  return csv;
-}
 
 double interpolate(const std::vector<double>& t, const std::vector<double>& y, double x) {
   if (x <= t.front()) return y.front();
@@ -103,7 +69,7 @@ class StreamingCsv {
 }  // namespace
 
 int replay_command(const ReplayArgs& args) {
-  const Csv recorded = read_csv(args.input);
+  const engine::CsvFile recorded = engine::read_csv(args.input);
   if (recorded.names.empty() || recorded.names[0] != "t")
     throw engine::InputError(args.input, 1, "t", "the first column must be the time t [s]");
   const std::string input = std::filesystem::absolute(args.input).string();

@@ -1,0 +1,40 @@
+// Recorded signals against time for source blocks (tables, steering records, shaker pads):
+// read from a CSV file named in the block's settings, interpolated linearly or by cubic Hermite
+// segments (value and slope continuous: a recorded displacement and its rate).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "engine/block_settings.hpp"
+
+namespace dydp::blocks {
+
+class TimeSeries {
+ public:
+  TimeSeries() = default;
+  TimeSeries(std::vector<double> t, std::vector<double> y) : t_(std::move(t)), y_(std::move(y)) {}
+
+  /// Linear interpolation, held constant outside the samples.
+  double linear(double t) const;
+  /// Cubic Hermite interpolation with central-difference slopes (one-sided at the ends), held
+  /// constant outside; value and rate.
+  void cubic(double t, double& y, double& ydot) const;
+  const std::vector<double>& times() const { return t_; }
+  const std::vector<double>& values() const { return y_; }
+
+ private:
+  size_t segment(double t) const;
+  double slope(size_t k) const;
+  std::vector<double> t_, y_;
+};
+
+/// Reads the columns `columns` against `time_column` from the CSV file in setting `file_key`;
+/// errors name the setting (missing column) or the file and row (bad data, times not
+/// increasing, fewer than two rows).
+std::vector<TimeSeries> read_time_series(const engine::BlockSettings& s, const std::string& file_key,
+                                         const std::string& time_column,
+                                         const std::vector<std::string>& columns,
+                                         const std::string& columns_key);
+
+}  // namespace dydp::blocks
