@@ -526,3 +526,22 @@ TEST_F(Cli, ReplayOfASceneWithoutRecordedInputExitsTwo) {
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("input_file"), std::string::npos) << r.err;
 }
+
+// ---------------------------------------------------------------- every scene
+
+// Every scene in scenarios/ (the README's among them) loads and runs to completion with
+// finite objectives.
+TEST_F(Cli, EveryScenarioRuns) {
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(DYDP_SOURCE_DIR) / "scenarios")) {
+    if (entry.path().extension() != ".yaml") continue;
+    const fs::path out = dir_ / entry.path().stem();
+    const Result r = dydp("run " + quote(entry.path().string()) + " --out " + quote(out.string()));
+    ASSERT_EQ(r.status, 0) << entry.path() << "\n" << r.err;
+    const json objectives = json::parse(read_text(out / "objectives.json"))["objectives"];
+    for (const auto& [name, o] : objectives.items())
+      EXPECT_TRUE(std::isfinite(o["value"].get<double>())) << entry.path() << " " << name;
+    ++count;
+  }
+  EXPECT_GE(count, 5);
+}
