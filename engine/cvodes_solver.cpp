@@ -309,6 +309,26 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
       std::string reason = std::string("CVode failed: ") + CVodeGetReturnFlagName(flag);
       if (!P.cvodes_message.empty()) reason += " (" + P.cvodes_message + ")";
       std::string block;
+      // Name the state CVODES could not hold to its tolerance: the largest weighted local error.
+      if (flag == CV_ERR_FAILURE || flag == CV_CONV_FAILURE || flag == CV_TOO_MUCH_WORK) {
+        N_Vector ele = N_VClone(S.y), weights = N_VClone(S.y);
+        if (CVodeGetEstLocalErrors(S.mem, ele) == CV_SUCCESS && CVodeGetErrWeights(S.mem, weights) == CV_SUCCESS) {
+          int worst = -1;
+          double largest = -1.0;
+          for (int i = 0; i < nx; ++i) {
+            const double e = std::fabs(NV_Ith_S(ele, i) * NV_Ith_S(weights, i));
+            if (e > largest) largest = e, worst = i;
+          }
+          for (const Node& n : d.nodes)
+            if (worst >= n.state_offset && worst < n.state_offset + n.block->num_states()) {
+              block = n.name;
+              reason += "; largest estimated local error in state " +
+                        n.block->state_names()[worst - n.state_offset];
+            }
+        }
+        N_VDestroy(ele);
+        N_VDestroy(weights);
+      }
       if (!P.refusal.empty()) {
         block = P.refusal.substr(0, P.refusal.find(':'));
         reason += "; last refused point at t = " + std::to_string(P.refusal_t) + " s: " + P.refusal;

@@ -54,4 +54,13 @@ class SolverError : public std::runtime_error {
   std::string block_;
 };
 
+/// A fixed-step method cannot retry: an input out of a block's domain ends the run. The
+/// reason comes as "block: why" from the evaluator.
+template <class DomainError>
+SolverError domain_failure(double t, const DomainError& e) {
+  const auto colon = e.reason.find(": ");
+  if (colon == std::string::npos) return SolverError(t, "", "input out of a block's domain: " + e.reason);
+  return SolverError(t, e.reason.substr(0, colon), "input out of the block's domain: " + e.reason.substr(colon + 2));
+}
+
 }  // namespace dydp::engine

@@ -5,6 +5,19 @@
 #include <cstring>
 
 namespace dydp::engine {
+namespace {
+
+/// Calls a block function; an OutOfDomain it throws comes out naming the block.
+template <class F>
+void call_block(const Node& n, F&& f) {
+  try {
+    f();
+  } catch (const OutOfDomain& e) {
+    throw OutOfDomain{n.name + ": " + e.reason};
+  }
+}
+
+}  // namespace
 
 Evaluator::Evaluator(const Diagram& d, bool with_sensitivities)
     : d_(d), ns_(with_sensitivities ? static_cast<int>(d.sensitivities.size()) : 0),
@@ -120,7 +133,7 @@ void Evaluator::outputs(double t, const double* x) {
       for (size_t k = 0; k < n.output_offset.size(); ++k) y_[k] = sig_.data() + n.output_offset[k];
       Eval e = eval_for(n, i, t, x);
       e.inputs_ready = pass == 1;
-      n.block->outputs(e, y_.data());
+      call_block(n, [&] { n.block->outputs(e, y_.data()); });
       if (time_only_[i]) source_valid_[i] = true, source_t_[i] = t, source_segment_[i] = segment_start_;
     }
   valid_ = true;
@@ -133,7 +146,7 @@ void Evaluator::derivatives(double t, const double* x, double* xdot) {
   for (size_t i = 0; i < d_.nodes.size(); ++i) {
     const Node& n = d_.nodes[i];
     if (n.block->num_states() == 0) continue;
-    n.block->derivatives(eval_for(n, static_cast<int>(i), t, x), xdot + n.state_offset);
+    call_block(n, [&] { n.block->derivatives(eval_for(n, static_cast<int>(i), t, x), xdot + n.state_offset); });
   }
 }
 
@@ -142,7 +155,7 @@ void Evaluator::quadratures(double t, const double* x, double* qdot) {
   for (size_t i = 0; i < d_.nodes.size(); ++i) {
     const Node& n = d_.nodes[i];
     if (n.block->num_quadratures() == 0) continue;
-    n.block->quadratures(eval_for(n, static_cast<int>(i), t, x), qdot + n.quad_offset);
+    call_block(n, [&] { n.block->quadratures(eval_for(n, static_cast<int>(i), t, x), qdot + n.quad_offset); });
   }
 }
 
@@ -171,7 +184,7 @@ void Evaluator::tangents(double t, const double* x, int nd, ConstDirView dx, boo
       }
       Eval e = eval_for(n, i, t, x);
       e.inputs_ready = pass == 1;
-      n.block->outputs_tangent(e, s, dy_.data());
+      call_block(n, [&] { n.block->outputs_tangent(e, s, dy_.data()); });
     }
   for (size_t i = 0; i < d_.nodes.size(); ++i) {
     const Node& n = d_.nodes[i];
@@ -181,8 +194,10 @@ void Evaluator::tangents(double t, const double* x, int nd, ConstDirView dx, boo
     const int idx = static_cast<int>(i);
     const Eval e = eval_for(n, idx, t, x);
     const Seeds s = seeds_for(n, idx, nd, dx, with_params);
-    if (states) n.block->derivatives_tangent(e, s, {dxdot.data + n.state_offset, dxdot.ld});
-    if (quads) n.block->quadratures_tangent(e, s, {dqdot.data + n.quad_offset, dqdot.ld});
+    call_block(n, [&] {
+      if (states) n.block->derivatives_tangent(e, s, {dxdot.data + n.state_offset, dxdot.ld});
+      if (quads) n.block->quadratures_tangent(e, s, {dqdot.data + n.quad_offset, dqdot.ld});
+    });
   }
 }
 

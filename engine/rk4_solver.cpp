@@ -64,7 +64,7 @@ RunResult run_rk4(const Diagram& d, const RunOptions& options) {
         ++st.sens_rhs_evals;
       }
     } catch (const OutOfDomain& e) {
-      throw SolverError(t, "", "input out of a block's domain: " + e.reason);
+      throw domain_failure(t, e);
     }
   };
   auto axpy = [](std::vector<double>& out, const std::vector<double>& base, double a,

@@ -104,7 +104,7 @@ class Stepper {
     try {
       call();
     } catch (const OutOfDomain& e) {
-      throw SolverError(t, "", "input out of a block's domain: " + e.reason);
+      throw domain_failure(t, e);
     }
   }
 

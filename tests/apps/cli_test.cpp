@@ -545,3 +545,68 @@ TEST_F(Cli, EveryScenarioRuns) {
   }
   EXPECT_GE(count, 5);
 }
+
+// ---------------------------------------------------------------- stress suite
+
+std::string scene_text(const fs::path& p) { return read_text(p); }
+
+// Every stress scene either completes with finite objectives or stops with exit 1 and a message
+// naming the time and the block.
+TEST_F(Cli, StressScenesCompleteOrStopNamingTimeAndBlock) {
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(DYDP_SOURCE_DIR) / "scenarios" / "stress")) {
+    if (entry.path().extension() != ".yaml") continue;
+    const fs::path out = dir_ / entry.path().stem();
+    const Result r = dydp("run " + quote(entry.path().string()) + " --out " + quote(out.string()));
+    ++count;
+    if (r.status == 0) {
+      for (const auto& [name, o] : json::parse(read_text(out / "objectives.json"))["objectives"].items()) {
+        EXPECT_TRUE(std::isfinite(o["value"].get<double>())) << entry.path() << " " << name;
+        for (const auto& [p, g] : o["sensitivity"].items()) EXPECT_TRUE(std::isfinite(g.get<double>())) << p;
+      }
+      continue;
+    }
+    EXPECT_EQ(r.status, 1) << entry.path() << "\n" << r.err;
+    EXPECT_NE(r.err.find("t = "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("block "), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out / "signals.csv")) << "nothing half written";
+  }
+  EXPECT_GE(count, 6);
+}
+
+// RK4 at a millisecond step on the stiffest scene reports the instability instead of writing non-finite numbers.
+TEST_F(Cli, StiffHydraulicsFailuresAreReportedNotWritten) {
+  const fs::path src = fs::path(DYDP_SOURCE_DIR) / "scenarios" / "stress" / "bulk_modulus_100x.yaml";
+  std::string text = scene_text(src);
+  const std::string solver = "solver: {method: bdf, rtol: 1.0e-6, atol: 1.0e-8, sens_error_test: false}";
+  ASSERT_NE(text.find(solver), std::string::npos);
+  std::string rk4 = text;
+  rk4.replace(rk4.find(solver), solver.size(), "solver: {method: rk4, step: 0.001}");
+  const Result r = dydp("run " + quote(write("rk4.yaml", rk4)) + " --out " + quote((dir_ / "rk4").string()));
+  // The instability shows as pressures leaving their domain (or as non-finite numbers).
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("block damper"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.err.find("not finite") != std::string::npos || r.err.find("domain") != std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "rk4" / "signals.csv"));
+}
+
+// Across the pothole's edges (breakpoints, wheel lift-off) the exact sensitivity of the comfort
+// figure to the valve current agrees with central differences of whole runs.
+TEST_F(Cli, PotholeSensitivityAgreesWithCentralDifferences) {
+  std::string text = scene_text(fs::path(DYDP_SOURCE_DIR) / "scenarios" / "stress" / "pothole_lift_off.yaml");
+  const std::string solver = "solver: {method: bdf, rtol: 1.0e-6, atol: 1.0e-8}";
+  ASSERT_NE(text.find(solver), std::string::npos);
+  text.replace(text.find(solver), solver.size(), "solver: {method: bdf, rtol: 1.0e-9, atol: 1.0e-11}");
+  const std::string scene = write("pothole.yaml", text);
+  const fs::path out = dir_ / "sweep";
+  const Result r = dydp("sweep " + quote(scene) + " --param valve_current --range 0.8:0.8:1 --fd 0.01,0.001,0.0001 --out " +
+                        quote(out.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(read_text(out / "sweep.json"));
+  for (const auto& [name, o] : j["points"][0]["objectives"].items()) {
+    const double exact = o["sensitivity"].get<double>();
+    double best = INFINITY;
+    for (const auto& fd : o["fd"]) best = std::min(best, std::fabs(fd["value"].get<double>() - exact));
+    EXPECT_LT(best, 1e-4 * std::fabs(exact)) << name << " exact " << exact << "\n" << o.dump();
+  }
+}
