@@ -535,6 +535,9 @@ TEST_F(Cli, EveryScenarioRuns) {
   int count = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(DYDP_SOURCE_DIR) / "scenarios")) {
     if (entry.path().extension() != ".yaml") continue;
+    // The full car's 20 s on the rig takes about a minute in an optimised build: the sanitizer
+    // build (several times slower) leaves it to the optimised one.
+    if (DYDP_SANITIZED && entry.path().stem() == "fourposter_comfort") continue;
     const fs::path out = dir_ / entry.path().stem();
     const Result r = dydp("run " + quote(entry.path().string()) + " --out " + quote(out.string()));
     ASSERT_EQ(r.status, 0) << entry.path() << "\n" << r.err;
@@ -543,7 +546,7 @@ TEST_F(Cli, EveryScenarioRuns) {
       EXPECT_TRUE(std::isfinite(o["value"].get<double>())) << entry.path() << " " << name;
     ++count;
   }
-  EXPECT_GE(count, 5);
+  EXPECT_GE(count, DYDP_SANITIZED ? 5 : 6);
 }
 
 // ---------------------------------------------------------------- stress suite
