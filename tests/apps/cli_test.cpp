@@ -563,7 +563,8 @@ TEST_F(Cli, StressScenesCompleteOrStopNamingTimeAndBlock) {
     const Result r = dydp("run " + quote(entry.path().string()) + " --out " + quote(out.string()));
     ++count;
     if (r.status == 0) {
-      for (const auto& [name, o] : json::parse(read_text(out / "objectives.json"))["objectives"].items()) {
+      const json objectives = json::parse(read_text(out / "objectives.json"))["objectives"];
+      for (const auto& [name, o] : objectives.items()) {
         EXPECT_TRUE(std::isfinite(o["value"].get<double>())) << entry.path() << " " << name;
         for (const auto& [p, g] : o["sensitivity"].items()) EXPECT_TRUE(std::isfinite(g.get<double>())) << p;
       }
