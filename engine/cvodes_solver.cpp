@@ -54,13 +54,12 @@ void scatter(const std::vector<double>& in, int n, int count, N_Vector* v) {
   for (int c = 0; c < count; ++c) std::copy_n(in.data() + c * n, n, NV_DATA_S(v[c]));
 }
 
-int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
-  auto& P = *static_cast<Problem*>(user);
-  double* xdot = NV_DATA_S(ydot);
-  if (!P.scene_values.empty()) P.ev.use_parameter_values(P.scene_values.data());
-  if (P.nx == 0) xdot[0] = 0.0;
+/// Runs a callback body for CVODES: 0 on success, 1 (recoverable: retry with a smaller step)
+/// when a block refused the point, -1 on any other failure; the refusal is remembered.
+template <class F>
+int guarded(Problem& P, double t, F&& body) {
   try {
-    P.ev.derivatives(t, NV_DATA_S(y), xdot);
+    body();
   } catch (const OutOfDomain& e) {
     P.refuse(t, e.reason);
     return 1;
@@ -68,6 +67,15 @@ int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
     P.refuse(t, e.what());
     return -1;
   }
+  return 0;
+}
+
+int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
+  auto& P = *static_cast<Problem*>(user);
+  double* xdot = NV_DATA_S(ydot);
+  if (!P.scene_values.empty()) P.ev.use_parameter_values(P.scene_values.data());
+  if (P.nx == 0) xdot[0] = 0.0;
+  if (const int flag = guarded(P, t, [&] { P.ev.derivatives(t, NV_DATA_S(y), xdot); })) return flag;
   if (!P.ev.all_finite(xdot)) {
     P.refuse(t, P.ev.find_nonfinite(xdot));
     return 1;  // recoverable: CVODES retries with a smaller step, then fails naming it
@@ -78,20 +86,13 @@ int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
 int sens_rhs(int ns, sunrealtype t, N_Vector y, N_Vector, N_Vector* yS, N_Vector* ySdot,
              void* user, N_Vector, N_Vector) {
   auto& P = *static_cast<Problem*>(user);
-  try {
+  return guarded(P, t, [&] {
     gather(yS, P.nx, ns, P.dx);
     P.dxdot.assign(static_cast<size_t>(P.nx) * ns, 0.0);
     P.ev.tangents(t, NV_DATA_S(y), ns, {P.dx.data(), P.nx}, true, {P.dxdot.data(), P.nx}, {});
     if (P.nx > 0) scatter(P.dxdot, P.nx, ns, ySdot);
     ++P.sens_passes;
-  } catch (const OutOfDomain& e) {
-    P.refuse(t, e.reason);
-    return 1;
-  } catch (const std::exception& e) {
-    P.refuse(t, e.what());
-    return -1;
-  }
-  return 0;
+  });
 }
 
 int jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix J, void* user, N_Vector, N_Vector,
@@ -99,18 +100,11 @@ int jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix J, void* user, N_Vec
   auto& P = *static_cast<Problem*>(user);
   SUNMatZero(J);
   if (P.nx == 0) return 0;
-  try {
+  return guarded(P, t, [&] {
     P.ev.tangents(t, NV_DATA_S(y), P.nx, {P.identity.data(), P.nx}, false,
                   {SM_DATA_D(J), static_cast<int>(SM_ROWS_D(J))}, {});
     ++P.jac_passes;
-  } catch (const OutOfDomain& e) {
-    P.refuse(t, e.reason);
-    return 1;
-  } catch (const std::exception& e) {
-    P.refuse(t, e.what());
-    return -1;
-  }
-  return 0;
+  });
 }
 
 int quad_rhs(sunrealtype t, N_Vector y, N_Vector qdot, void* user) {
