@@ -16,6 +16,21 @@ namespace {
 
 using symbolic::ParseError;
 
+// The two unit normals of a hinge's axis a (Cut::normals_a): n1 = the frame axis e with the
+// smallest |a . e|, minus its component along a, normalised; n2 = a x n1. For a = z: x and y.
+std::array<std::array<double, 3>, 2> hinge_normals(const std::array<double, 3>& a) {
+  int least = 0;
+  for (int i = 1; i < 3; ++i)
+    if (std::abs(a[i]) < std::abs(a[least])) least = i;
+  std::array<double, 3> n1{0.0, 0.0, 0.0};
+  n1[least] = 1.0;
+  for (int i = 0; i < 3; ++i) n1[i] -= a[least] * a[i];
+  const double norm = std::sqrt(n1[0] * n1[0] + n1[1] * n1[1] + n1[2] * n1[2]);
+  for (double& c : n1) c /= norm;
+  const std::array<double, 3> n2{a[1] * n1[2] - a[2] * n1[1], a[2] * n1[0] - a[0] * n1[2], a[0] * n1[1] - a[1] * n1[0]};
+  return {n1, n2};
+}
+
 class Loader {
  public:
   Loader(Model& model, std::string file) : m_(model), file_(std::move(file)) {}
@@ -115,6 +130,26 @@ class Loader {
       picked.push_back(found);
     }
     return picked;
+  }
+
+  // A hinge axis: x, y or z of the body's frame, or [x, y, z] in it (normalised).
+  std::array<double, 3> hinge_axis(const YAML::Node& node, const std::string& field) const {
+    std::array<double, 3> axis{0.0, 0.0, 0.0};
+    if (node.IsScalar()) {
+      const std::string s = node.Scalar();
+      if (s != "x" && s != "y" && s != "z") fail(node, field, "expected x, y, z or [x, y, z], got '" + s + "'");
+      axis[s[0] - 'x'] = 1.0;
+      return axis;
+    }
+    if (!node.IsSequence() || node.size() != 3) fail(node, field, "expected x, y, z or [x, y, z]");
+    double norm = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      axis[i] = number(node[i], field);
+      norm += axis[i] * axis[i];
+    }
+    if (norm < 1e-24) fail(node, field, "the axis is zero");
+    for (double& c : axis) c /= std::sqrt(norm);
+    return axis;
   }
 
   int joint_index(const YAML::Node& node, const std::string& field) const {
@@ -269,7 +304,7 @@ class Loader {
       for (std::size_t i = 0; i < cs.size(); ++i) {
         const YAML::Node c = cs[i];
         std::string field = "cuts[" + std::to_string(i) + "]";
-        check_keys(c, field, {"name", "type", "a", "b", "components", "length"});
+        check_keys(c, field, {"name", "type", "a", "b", "components", "length", "axis", "axis_a", "axis_b"});
         Cut cut;
         cut.name = c["name"] ? text(c["name"], field + ".name") : "cut" + std::to_string(i + 1);
         field = "cuts." + cut.name;
@@ -292,9 +327,25 @@ class Loader {
           cut.type = Cut::Type::Distance;
           if (!c["length"]) fail(c, field + ".length", "missing");
           cut.length = value(c["length"], field + ".length");
+        } else if (type == "hinge") {
+          cut.type = Cut::Type::Hinge;
+          for (const char* key : {"components", "length"})
+            if (c[key]) fail(c[key], field + "." + key, "not a key of a hinge");
+          // `axis` for both bodies (frames parallel in the assembled position), or one each
+          auto body_axis = [&](const std::string& key) {
+            if (const YAML::Node own = c[key]) return hinge_axis(own, field + "." + key);
+            if (const YAML::Node both = c["axis"]) return hinge_axis(both, field + ".axis");
+            fail(c, field + "." + key, "missing (a hinge needs axis, or axis_a and axis_b: x, y, z or [x, y, z])");
+          };
+          cut.axis_a = body_axis("axis_a");
+          cut.axis_b = body_axis("axis_b");
+          cut.normals_a = hinge_normals(cut.axis_a);
         } else {
-          fail(c["type"] ? c["type"] : c, field + ".type", "expected ball or distance");
+          fail(c["type"] ? c["type"] : c, field + ".type", "expected ball, distance or hinge");
         }
+        if (cut.type != Cut::Type::Hinge)
+          for (const char* key : {"axis", "axis_a", "axis_b"})
+            if (c[key]) fail(c[key], field + "." + key, "only a hinge takes " + std::string(key));
         m_.cuts.push_back(cut);
       }
     }
@@ -459,7 +510,7 @@ class Loader {
 
 int Model::constraint_count() const {
   int m = 0;
-  for (const Cut& c : cuts) m += c.type == Cut::Type::Ball ? static_cast<int>(c.components.size()) : 1;
+  for (const Cut& c : cuts) m += c.equations();
   return m;
 }
 

@@ -69,13 +69,23 @@ struct PointRef {
 };
 
 // Cut joints. Ball: the two points coincide (components x, y, z in the ground frame, optionally
-// a subset for planar models). Distance: |b - a| = length.
+// a subset for planar models). Distance: |b - a| = length. Hinge: the two points coincide (x, y,
+// z) and the axis fixed in b's body stays along the axis fixed in a's body: its components along
+// two unit normals n1, n2 of a's axis vanish, (R_a n1) . (R_b axis_b) = (R_a n2) . (R_b axis_b) = 0
+// (5 equations).
 struct Cut {
   std::string name;
-  enum class Type { Ball, Distance } type = Type::Ball;
+  enum class Type { Ball, Distance, Hinge } type = Type::Ball;
   PointRef a, b;
   std::vector<int> components;  // ball: which of x, y, z
   Value length;                 // distance
+  // hinge: unit axes in the frames of a's and b's bodies, and the normals of axis_a (a's frame):
+  // n1 = the frame axis least along axis_a, made orthogonal to it and normalised; n2 = axis_a x n1.
+  std::array<double, 3> axis_a{0.0, 0.0, 1.0}, axis_b{0.0, 0.0, 1.0};
+  std::array<std::array<double, 3>, 2> normals_a{};
+  int equations() const {
+    return type == Type::Ball ? static_cast<int>(components.size()) : type == Type::Hinge ? 5 : 1;
+  }
 };
 
 // Internal force elements. Spring: linear spring-damper between two points, force

@@ -385,6 +385,16 @@ class Generator {
         V3 f = zero3();
         if (c.type == Cut::Type::Ball) {
           for (int comp : c.components) f[comp] = ctx_->element(out_.lam, row++);
+        } else if (c.type == Cut::Type::Hinge) {
+          for (int comp = 0; comp < 3; ++comp) f[comp] = ctx_->element(out_.lam, row++);
+          // The alignment rows h = (R_a n) . (R_b axis_b) vary by (dtheta_b - dtheta_a) . (b x n):
+          // their multipliers are the torques lam (b x n) on b and the opposite on a.
+          const HingeAxes axes = hinge_axes(c);
+          V3 torque = zero3();
+          for (const V3& normal : axes.normals) torque = torque + ctx_->element(out_.lam, row++) * cross(axes.b, normal);
+          torque = assign("TC", row - 1, torque);
+          if (c.b.body != 0) ext_n[c.b.body] = ext_n[c.b.body] + body_rotation(c.b.body).apply_transpose(torque);
+          if (c.a.body != 0) ext_n[c.a.body] = ext_n[c.a.body] - body_rotation(c.a.body).apply_transpose(torque);
         } else {
           const V3 d = point_position(c.b) - point_position(c.a);
           const Expr length = all_->assign("LC" + std::to_string(row + 1), symbolic::sqrt(dot(d, d)));
@@ -454,11 +464,29 @@ class Generator {
       const V3 d = point_position(c.b) - point_position(c.a);
       if (c.type == Cut::Type::Ball) {
         for (int comp : c.components) h.push_back(all_->assign("H" + std::to_string(++row), d[comp]));
+      } else if (c.type == Cut::Type::Hinge) {
+        for (int comp = 0; comp < 3; ++comp) h.push_back(all_->assign("H" + std::to_string(++row), d[comp]));
+        const HingeAxes axes = hinge_axes(c);
+        for (const V3& normal : axes.normals) h.push_back(all_->assign("H" + std::to_string(++row), dot(normal, axes.b)));
       } else {
         h.push_back(all_->assign("H" + std::to_string(++row), symbolic::sqrt(dot(d, d)) - val(c.length)));
       }
     }
     return h;
+  }
+
+  // A hinge cut's axes in ground components: axis_b carried by b's body, the normals of axis_a
+  // by a's body (Cut::normals_a).
+  struct HingeAxes {
+    V3 b;
+    std::array<V3, 2> normals;
+  };
+  HingeAxes hinge_axes(const Cut& c) {
+    auto constant = [&](const std::array<double, 3>& v) {
+      return V3{{ctx_->constant(v[0]), ctx_->constant(v[1]), ctx_->constant(v[2])}};
+    };
+    const Rot ra = body_rotation(c.a.body), rb = body_rotation(c.b.body);
+    return {rb.apply(constant(c.axis_b)), {ra.apply(constant(c.normals_a[0])), ra.apply(constant(c.normals_a[1]))}};
   }
 
   V3 point_acceleration(PointRef p) {

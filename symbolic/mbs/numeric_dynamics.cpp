@@ -141,6 +141,17 @@ NumericDynamics::Vector NumericDynamics::residual(const Vector& q, const Vector&
       for (int comp : c.components) f[comp] = lam.size() ? lam[row++] : 0.0;
       apply(c.b, f);
       apply(c.a, -f);
+    } else if (c.type == Cut::Type::Hinge) {
+      // a force at the joined points and a torque normal to the hinge axis: the virtual work of
+      // lam on the constraint variations dh (see constraint_jacobian)
+      V3 f = V3::Zero(), moment = V3::Zero();
+      const HingeFrame axes = hinge_frame(k, c);
+      for (int comp = 0; comp < 3; ++comp) f[comp] = lam.size() ? lam[row++] : 0.0;
+      for (const V3& normal : axes.normals) moment += (lam.size() ? lam[row++] : 0.0) * axes.b.cross(normal);
+      apply(c.b, f);
+      apply(c.a, -f);
+      if (c.b.body != 0) torque[c.b.body] += moment;
+      if (c.a.body != 0) torque[c.a.body] -= moment;
     } else {
       const V3 d = point_position(k, c.b) - point_position(k, c.a);
       const V3 f = (lam.size() ? lam[row++] : 0.0) * d / d.norm();
@@ -227,6 +238,10 @@ NumericDynamics::Vector NumericDynamics::constraints(const Vector& q) const {
     const V3 d = point_position(k, c.b) - point_position(k, c.a);
     if (c.type == Cut::Type::Ball) {
       for (int comp : c.components) h[row++] = d[comp];
+    } else if (c.type == Cut::Type::Hinge) {
+      const HingeFrame axes = hinge_frame(k, c);
+      for (int comp = 0; comp < 3; ++comp) h[row++] = d[comp];
+      for (const V3& normal : axes.normals) h[row++] = normal.dot(axes.b);
     } else {
       h[row++] = d.norm() - value(c.length);
     }
@@ -249,6 +264,25 @@ NumericDynamics::Matrix NumericDynamics::point_jacobian(const Vector& q, PointRe
   return J;
 }
 
+NumericDynamics::HingeFrame NumericDynamics::hinge_frame(const Kinematics& k, const Cut& c) const {
+  const M3 Ra = frame_rotation(k, c.a.body);
+  const V3 n1(c.normals_a[0][0], c.normals_a[0][1], c.normals_a[0][2]);
+  const V3 n2(c.normals_a[1][0], c.normals_a[1][1], c.normals_a[1][2]);
+  return {frame_rotation(k, c.b.body) * V3(c.axis_b[0], c.axis_b[1], c.axis_b[2]), {Ra * n1, Ra * n2}};
+}
+
+NumericDynamics::Matrix NumericDynamics::angular_jacobian(const Kinematics& k, int body) const {
+  const int frame = model_.bodies[body].frame;
+  Matrix J = Matrix::Zero(3, n());
+  for (int j = 0; j < n(); ++j) {
+    const Joint& joint = model_.joints[j];
+    if (frame < 0 || !is_revolute(joint.type) || !is_ancestor(j, frame)) continue;
+    const M3 Rp = joint.parent >= 0 ? k.rotation[joint.parent] : M3::Identity();
+    J.col(j) = Rp * axis_of_joint(joint);
+  }
+  return J;
+}
+
 NumericDynamics::Matrix NumericDynamics::constraint_jacobian(const Vector& q) const {
   const Kinematics k = kinematics(q, Vector::Zero(n()), Vector::Zero(n()));
   Matrix J(m(), n());
@@ -257,6 +291,14 @@ NumericDynamics::Matrix NumericDynamics::constraint_jacobian(const Vector& q) co
     const Matrix Jd = point_jacobian(q, c.b) - point_jacobian(q, c.a);
     if (c.type == Cut::Type::Ball) {
       for (int comp : c.components) J.row(row++) = Jd.row(comp);
+    } else if (c.type == Cut::Type::Hinge) {
+      for (int comp = 0; comp < 3; ++comp) J.row(row++) = Jd.row(comp);
+      // d/dq of (n . b) with n turning with a's body and b with b's: (omega_b - omega_a) . (b x n)
+      // per unit joint rate, where the body's angular velocity gains the ground axis of every
+      // revolute joint on its path to the ground.
+      const HingeFrame axes = hinge_frame(k, c);
+      const Matrix Jw = angular_jacobian(k, c.b.body) - angular_jacobian(k, c.a.body);
+      for (const V3& normal : axes.normals) J.row(row++) = axes.b.cross(normal).transpose() * Jw;
     } else {
       const V3 d = point_position(k, c.b) - point_position(k, c.a);
       J.row(row++) = (d / d.norm()).transpose() * Jd;
@@ -273,6 +315,19 @@ NumericDynamics::Vector NumericDynamics::constraint_bias(const Vector& q, const 
     const V3 acc = point_acceleration(k, c.b) - point_acceleration(k, c.a);
     if (c.type == Cut::Type::Ball) {
       for (int comp : c.components) b[row++] = acc[comp];
+    } else if (c.type == Cut::Type::Hinge) {
+      for (int comp = 0; comp < 3; ++comp) b[row++] = acc[comp];
+      // h = n . b with n' = w_a x n, b' = w_b x b: h'' = n'' . b + 2 n' . b' + n . b'', where
+      // v'' = alpha x v + w x (w x v) and alpha holds only the velocity terms (qdd = 0)
+      const HingeFrame axes = hinge_frame(k, c);
+      const int fa = model_.bodies[c.a.body].frame, fb = model_.bodies[c.b.body].frame;
+      const V3 wa = fa < 0 ? V3::Zero() : k.omega[fa], wb = fb < 0 ? V3::Zero() : k.omega[fb];
+      const V3 aa = fa < 0 ? V3::Zero() : k.alpha[fa], ab = fb < 0 ? V3::Zero() : k.alpha[fb];
+      const V3 b_rate = wb.cross(axes.b), b_acc = ab.cross(axes.b) + wb.cross(b_rate);
+      for (const V3& normal : axes.normals) {
+        const V3 n_rate = wa.cross(normal), n_acc = aa.cross(normal) + wa.cross(n_rate);
+        b[row++] = n_acc.dot(axes.b) + 2.0 * n_rate.dot(b_rate) + normal.dot(b_acc);
+      }
     } else {
       // h = |d| - L: hddot = u . dddot + |ddot_perp|^2 / |d|
       const V3 d = point_position(k, c.b) - point_position(k, c.a);

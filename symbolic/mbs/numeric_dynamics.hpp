@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
 #include <vector>
 
 #include "symbolic/mbs/model.hpp"
@@ -60,6 +61,13 @@ class NumericDynamics {
   V3 point_acceleration(const Kinematics& k, PointRef p) const;
   M3 frame_rotation(const Kinematics& k, int body) const;
   V3 frame_origin(const Kinematics& k, int body) const;
+  // A hinge cut's axis_b carried by b's body and the normals of axis_a by a's, ground components.
+  struct HingeFrame {
+    V3 b;
+    std::array<V3, 2> normals;
+  };
+  HingeFrame hinge_frame(const Kinematics& k, const Cut& c) const;
+  Matrix angular_jacobian(const Kinematics& k, int body) const;  // d(omega of body)/d(qd), 3 x n
   V3 vec(const Vec3Value& v) const { return {value(v[0]), value(v[1]), value(v[2])}; }
   double value(const Value& v) const { return model_.value(v); }
   bool is_ancestor(int joint, int descendant) const;

@@ -70,8 +70,22 @@ TEST(ModelLoader, ErrorsNameFileLineAndField) {
        "tiny.mbs.yaml:14: bodies[1].colour: unknown key"},
       {"cuts:\n  - {name: c1, type: ball, a: arm.tip, b: ground.D}\n",
        "tiny.mbs.yaml:12: cuts.c1.b: body 'ground' has no anchor 'D'"},
+      {"cuts:\n  - {name: c1, type: slot, a: arm.tip, b: ground.C}\n",
+       "tiny.mbs.yaml:12: cuts.c1.type: expected ball, distance or hinge"},
       {"cuts:\n  - {name: c1, type: hinge, a: arm.tip, b: ground.C}\n",
-       "tiny.mbs.yaml:12: cuts.c1.type: expected ball or distance"},
+       "tiny.mbs.yaml:12: cuts.c1.axis_a: missing (a hinge needs axis, or axis_a and axis_b: x, y, z or [x, y, z])"},
+      {"cuts:\n  - {name: c1, type: hinge, a: arm.tip, b: ground.C, axis_a: z}\n",
+       "tiny.mbs.yaml:12: cuts.c1.axis_b: missing (a hinge needs axis, or axis_a and axis_b: x, y, z or [x, y, z])"},
+      {"cuts:\n  - {name: c1, type: hinge, a: arm.tip, b: ground.C,\n     axis: w}\n",
+       "tiny.mbs.yaml:13: cuts.c1.axis: expected x, y, z or [x, y, z], got 'w'"},
+      {"cuts:\n  - {name: c1, type: hinge, a: arm.tip, b: ground.C, axis_a: x,\n     axis_b: [0, 1]}\n",
+       "tiny.mbs.yaml:13: cuts.c1.axis_b: expected x, y, z or [x, y, z]"},
+      {"cuts:\n  - {name: c1, type: hinge, a: arm.tip, b: ground.C, axis: [0, 0, 0]}\n",
+       "tiny.mbs.yaml:12: cuts.c1.axis: the axis is zero"},
+      {"cuts:\n  - {name: c1, type: hinge, a: arm.tip, b: ground.C, axis: z, length: 0.1}\n",
+       "tiny.mbs.yaml:12: cuts.c1.length: not a key of a hinge"},
+      {"cuts:\n  - {name: c1, type: ball, a: arm.tip, b: ground.C, axis: z}\n",
+       "tiny.mbs.yaml:12: cuts.c1.axis: only a hinge takes axis"},
       {"loads:\n  - {name: f, type: link_force, a: arm.tip, b: ground.C, sense: sideways}\n",
        "tiny.mbs.yaml:12: loads.f.sense: expected tension or compression"},
       {"loads:\n  - {name: f, type: link_force, a: arm.tip, b: ground.C, frame: arm}\n",
@@ -118,6 +132,37 @@ sensors:
   EXPECT_EQ(m.sensor_output_names(), (std::vector<std::string>{"travel.rate", "spin.x", "spin.y", "spin.z"}));
   EXPECT_TRUE(m.sensors[0].compression);
   EXPECT_EQ(m.sensors[0].reference.param, 0);
+}
+
+TEST(ModelLoader, ReadsHingeCuts) {
+  const Model m = parse_model(kBase + R"(  - name: b2
+    joints: [{name: q2, type: Rx}]
+    mass: 1
+    anchors: {P: [0, 0, 0]}
+cuts:
+  - {name: both, type: hinge, a: arm.tip, b: b2.P, axis: z}
+  - {name: own, type: hinge, a: b2.P, b: ground.C, axis_a: [0, 3, 4], axis_b: x}
+)", "tiny.mbs.yaml");
+  ASSERT_EQ(m.cuts.size(), 2u);
+  EXPECT_EQ(m.constraint_count(), 10);
+  const Cut& both = m.cuts[0];
+  EXPECT_EQ(both.type, Cut::Type::Hinge);
+  EXPECT_EQ(both.axis_a, (std::array<double, 3>{0, 0, 1}));
+  EXPECT_EQ(both.axis_b, (std::array<double, 3>{0, 0, 1}));
+  EXPECT_EQ(both.normals_a[0], (std::array<double, 3>{1, 0, 0}));
+  EXPECT_EQ(both.normals_a[1], (std::array<double, 3>{0, 1, 0}));
+  const Cut& own = m.cuts[1];
+  EXPECT_NEAR(own.axis_a[1], 0.6, 1e-15);
+  EXPECT_NEAR(own.axis_a[2], 0.8, 1e-15);
+  EXPECT_EQ(own.axis_b, (std::array<double, 3>{1, 0, 0}));
+  // the normals and the axis are an orthonormal frame
+  for (const auto& n : own.normals_a) {
+    EXPECT_NEAR(n[0] * n[0] + n[1] * n[1] + n[2] * n[2], 1.0, 1e-15);
+    EXPECT_NEAR(n[0] * own.axis_a[0] + n[1] * own.axis_a[1] + n[2] * own.axis_a[2], 0.0, 1e-15);
+  }
+  const auto& n1 = own.normals_a[0];
+  const auto& n2 = own.normals_a[1];
+  EXPECT_NEAR(n1[0] * n2[0] + n1[1] * n2[1] + n1[2] * n2[2], 0.0, 1e-15);
 }
 
 TEST(DydpGen, ModelErrorsExitWithStatusTwoAndTheMessage) {
