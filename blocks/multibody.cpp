@@ -2,11 +2,11 @@
 // coordinates u and velocities u_dot; dependent coordinates are solved by Newton-Raphson on the
 // generated constraints at every evaluation. Inputs: one port per load of the model (force or
 // torque in the load's declared frame, width 3 or the components declared; link force, width 1)
-// and per driven joint three scalar ports NAME, NAME_rate, NAME_acc (the commanded q, qd, qdd).
-// A driven joint follows its command through a stiff critically damped servo (two states,
-// r'' = acc + w^2 (q - r) + 2 w (rate - r'), w = 2 pi 30 Hz): positions and velocities then
-// read states only, so feedback through tyres or springs is no algebraic loop. Outputs:
-// q, qd, qdd (all coordinates, model order) and one port per sensor. Tangents go through the
+// and per driven joint three scalar ports NAME, NAME_rate, NAME_acc: its q, qd, qdd, imposed
+// directly. Outputs: q, qd, qdd (all coordinates, model order) and one port per sensor.
+// Positions and velocities (q, qd, the sensors that read no acceleration) read the states and
+// the driven joints' NAME and NAME_rate only, so feedback through tyres or springs is no
+// algebraic loop; qdd and the acceleration sensors read every input. Tangents go through the
 // generated tangent functions and the partitioning's tangent (ReducedDynamics::tangent).
 //
 // Types: `multibody` with setting `model: NAME` (the model's parameter values and initial
@@ -34,7 +34,6 @@ using Vector = Eigen::VectorXd;
 using Matrix = Eigen::MatrixXd;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kServoOmega = 2.0 * 3.14159265358979323846 * 30.0;  // [rad/s] driven-joint servo
 
 class Multibody : public Block {
  public:
@@ -49,18 +48,24 @@ class Multibody : public Block {
       declare_input(joint + "_rate", 1, "m/s or rad/s");
       declare_input(joint + "_acc", 1, "m/s^2 or rad/s^2");
     }
-    declare_output("q", g_.n, "m or rad", false);
-    declare_output("qd", g_.n, "m/s or rad/s", false);
-    declare_output("qdd", g_.n, "m/s^2 or rad/s^2", true);
-    for (int s = 0; s < g_.sensor_count; ++s)
-      declare_output(g_.sensor_ports[s], g_.sensor_widths[s], "", g_.sensor_reads_acceleration[s]);
+    // positions and velocities read the driven joints' q and qd; accelerations read everything
+    std::vector<int> driven_motion;
+    for (int i = 0; i < g_.driven_count; ++i) {
+      driven_motion.push_back(g_.loads + 3 * i);
+      driven_motion.push_back(g_.loads + 3 * i + 1);
+    }
+    declare_output("q", g_.n, "m or rad");
+    declare_output("qd", g_.n, "m/s or rad/s");
+    declare_output("qdd", g_.n, "m/s^2 or rad/s^2");
+    set_output_reads(0, driven_motion);
+    set_output_reads(1, driven_motion);
+    for (int s = 0; s < g_.sensor_count; ++s) {
+      declare_output(g_.sensor_ports[s], g_.sensor_widths[s], "");
+      if (!g_.sensor_reads_acceleration[s]) set_output_reads(3 + s, driven_motion);
+    }
     std::vector<std::string> states;
     for (int j : reduced_.independent()) states.push_back(std::string("q.") + g_.coordinate_names[j]);
     for (int j : reduced_.independent()) states.push_back(std::string("qd.") + g_.coordinate_names[j]);
-    for (int i = 0; i < g_.driven_count; ++i) {
-      states.push_back(std::string("q.") + g_.coordinate_names[g_.driven[i]]);
-      states.push_back(std::string("qd.") + g_.coordinate_names[g_.driven[i]]);
-    }
     declare_states(states);
   }
 
@@ -77,25 +82,19 @@ class Multibody : public Block {
       x0[i] = exposed_ ? e.p[g_.parameters + i] : g_.initial_q[reduced_.independent()[i]];
       x0[nu + i] = exposed_ ? e.p[g_.parameters + nu + i] : 0.0;
     }
-    for (int i = 0; i < g_.driven_count; ++i) {
-      x0[2 * nu + 2 * i] = g_.initial_q[g_.driven[i]];
-      x0[2 * nu + 2 * i + 1] = 0.0;
-    }
   }
   void initial_state_tangent(const Eval&, const Seeds& s, DirView dx0) const override {
     const int nu = reduced_.nu();
-    for (int d = 0; d < s.directions; ++d) {
+    for (int d = 0; d < s.directions; ++d)
       for (int i = 0; i < 2 * nu; ++i) dx0(i, d) = exposed_ ? s.p(g_.parameters + i, d) : 0.0;
-      for (int i = 2 * nu; i < 2 * nu + 2 * g_.driven_count; ++i) dx0(i, d) = 0.0;
-    }
   }
 
   void outputs(const Eval& e, double* const* y) const override {
     const ReducedDynamics::Result& r = solve(e);
     const int n = g_.n;
-    std::copy_n(r.q.data(), n, y[0]);
-    std::copy_n(r.qd.data(), n, y[1]);
-    if (e.inputs_ready) std::copy_n(r.qdd.data(), n, y[2]);
+    if (output_ready(e, 0)) std::copy_n(r.q.data(), n, y[0]);
+    if (output_ready(e, 1)) std::copy_n(r.qd.data(), n, y[1]);
+    if (output_ready(e, 2)) std::copy_n(r.qdd.data(), n, y[2]);
     if (g_.sensor_count == 0) return;
     std::vector<double> out(std::max(1, g_.sensor_outputs));
     const Vector lam = padded(r.lam);
@@ -103,7 +102,7 @@ class Multibody : public Block {
     g_.sensors(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), inp.data(), parameters(e), out.data());
     int at = 0;
     for (int s = 0; s < g_.sensor_count; ++s) {
-      if (e.inputs_ready || !Block::outputs()[3 + s].feedthrough) std::copy_n(out.data() + at, g_.sensor_widths[s], y[3 + s]);
+      if (output_ready(e, 3 + s)) std::copy_n(out.data() + at, g_.sensor_widths[s], y[3 + s]);
       at += g_.sensor_widths[s];
     }
   }
@@ -113,11 +112,12 @@ class Multibody : public Block {
     Matrix dq, dqd, dqdd, dinp, dp;
     tangent(e, s, r, dq, dqd, dqdd, dinp, dp);
     const int n = g_.n, nd = s.directions;
+    const bool motion = output_ready(e, 0), acceleration = output_ready(e, 2);
     for (int d = 0; d < nd; ++d)
       for (int i = 0; i < n; ++i) {
-        dy[0](i, d) = dq(i, d);
-        dy[1](i, d) = dqd(i, d);
-        if (e.inputs_ready) dy[2](i, d) = dqdd(i, d);
+        if (motion) dy[0](i, d) = dq(i, d);
+        if (motion) dy[1](i, d) = dqd(i, d);
+        if (acceleration) dy[2](i, d) = dqdd(i, d);
       }
     if (g_.sensor_count == 0 || nd == 0) return;
     const int ns = g_.sensor_outputs;
@@ -128,7 +128,7 @@ class Multibody : public Block {
                        dqd.data(), dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
     int at = 0;
     for (int k = 0; k < g_.sensor_count; ++k) {
-      if (e.inputs_ready || !Block::outputs()[3 + k].feedthrough)
+      if (output_ready(e, 3 + k))
         for (int d = 0; d < nd; ++d)
           for (int i = 0; i < g_.sensor_widths[k]; ++i) dy[3 + k](i, d) = dout[d * ns + at + i];
       at += g_.sensor_widths[k];
@@ -142,10 +142,6 @@ class Multibody : public Block {
       xdot[i] = e.x[nu + i];
       xdot[nu + i] = r.udd[i];
     }
-    for (int i = 0; i < g_.driven_count; ++i) {
-      xdot[2 * nu + 2 * i] = e.x[2 * nu + 2 * i + 1];
-      xdot[2 * nu + 2 * i + 1] = r.qdd[g_.driven[i]];
-    }
   }
 
   void derivatives_tangent(const Eval& e, const Seeds& s, DirView dxdot) const override {
@@ -153,16 +149,11 @@ class Multibody : public Block {
     Matrix dq, dqd, dqdd, dinp, dp;
     tangent(e, s, r, dq, dqd, dqdd, dinp, dp);
     const int nu = reduced_.nu();
-    for (int d = 0; d < s.directions; ++d) {
+    for (int d = 0; d < s.directions; ++d)
       for (int i = 0; i < nu; ++i) {
         dxdot(i, d) = s.x(nu + i, d);
         dxdot(nu + i, d) = dqdd(reduced_.independent()[i], d);
       }
-      for (int i = 0; i < g_.driven_count; ++i) {
-        dxdot(2 * nu + 2 * i, d) = s.x(2 * nu + 2 * i + 1, d);
-        dxdot(2 * nu + 2 * i + 1, d) = dqdd(g_.driven[i], d);
-      }
-    }
   }
 
  private:
@@ -172,24 +163,19 @@ class Multibody : public Block {
     return exposed_ && g_.parameters ? e.p : (g_.parameters ? g_.parameter_values : zero_);
   }
 
-  // The model's input array: load components from the ports, then q, qd, qdd of each driven
-  // joint from its servo states (qdd, the servo law, only once the inputs are ready).
+  // The model's input array: load components, then q, qd, qdd of each driven joint, from the
+  // ports that are ready (the others zero: no output read in this call depends on them; a
+  // driven joint not yet commanded sits at its assembly position).
   Vector inputs(const Eval& e) const {
     Vector in = Vector::Zero(std::max(1, g_.inputs));
-    const int nu = reduced_.nu();
-    for (int i = 0; i < g_.driven_count; ++i) {
-      in[g_.load_inputs + 3 * i] = e.x[2 * nu + 2 * i];
-      in[g_.load_inputs + 3 * i + 1] = e.x[2 * nu + 2 * i + 1];
-    }
-    if (!e.inputs_ready) return in;
     for (int k = 0; k < g_.loads; ++k)
-      for (int i = 0, at = load_offset(k); i < g_.load_widths[k]; ++i) in[at + i] = e.u[k][i];
-    for (int i = 0; i < g_.driven_count; ++i) {
-      const int port = g_.loads + 3 * i;
-      in[g_.load_inputs + 3 * i + 2] = e.u[port + 2][0] +
-                                       kServoOmega * kServoOmega * (e.u[port][0] - e.x[2 * nu + 2 * i]) +
-                                       2.0 * kServoOmega * (e.u[port + 1][0] - e.x[2 * nu + 2 * i + 1]);
-    }
+      if (e.input_ready(k))
+        for (int i = 0, at = load_offset(k); i < g_.load_widths[k]; ++i) in[at + i] = e.u[k][i];
+    for (int i = 0; i < g_.driven_count; ++i)
+      for (int j = 0; j < 3; ++j) {
+        const int port = g_.loads + 3 * i + j;
+        in[g_.load_inputs + 3 * i + j] = e.input_ready(port) ? e.u[port][0] : (j == 0 ? g_.initial_q[g_.driven[i]] : 0.0);
+      }
     return in;
   }
   int load_offset(int k) const {
@@ -240,17 +226,14 @@ class Multibody : public Block {
         du(i, d) = s.x(i, d);
         dud(i, d) = s.x(nu + i, d);
       }
-      for (int i = 0; i < g_.driven_count; ++i) {
-        const int at = g_.load_inputs + 3 * i, port = g_.loads + 3 * i;
-        dinp(at, d) = s.x(2 * nu + 2 * i, d);
-        dinp(at + 1, d) = s.x(2 * nu + 2 * i + 1, d);
-        if (e.inputs_ready)
-          dinp(at + 2, d) = s.u[port + 2](0, d) + kServoOmega * kServoOmega * (s.u[port](0, d) - s.x(2 * nu + 2 * i, d)) +
-                            2.0 * kServoOmega * (s.u[port + 1](0, d) - s.x(2 * nu + 2 * i + 1, d));
-      }
-      if (e.inputs_ready)
-        for (int k = 0; k < g_.loads; ++k)
+      for (int k = 0; k < g_.loads; ++k)
+        if (e.input_ready(k))
           for (int i = 0, at = load_offset(k); i < g_.load_widths[k]; ++i) dinp(at + i, d) = s.u[k](i, d);
+      for (int i = 0; i < g_.driven_count; ++i)
+        for (int j = 0; j < 3; ++j) {
+          const int port = g_.loads + 3 * i + j;
+          if (e.input_ready(port)) dinp(g_.load_inputs + 3 * i + j, d) = s.u[port](0, d);
+        }
       if (exposed_)
         for (int i = 0; i < g_.parameters; ++i) dp(i, d) = s.p(i, d);
     }

@@ -3,6 +3,8 @@
 // Blocks are stateless code over the numbers the engine hands them (Eval, Seeds).
 #pragma once
 
+#include <algorithm>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,10 +31,15 @@ struct PortDecl {
   std::string name;
   int width = 1;
   std::string unit;
-  /// Input: some output reads this input directly (without a state in between).
-  /// Output: this output reads some input directly. Algebraic loops are cycles through such
-  /// input -> output pairs; an output that reads states only breaks the cycle.
+  /// Input: the outputs that do not list their inputs (`reads`) read this input directly
+  /// (without a state in between).
+  /// Output: this output reads some input directly. Algebraic loops are cycles through
+  /// input -> output pairs where the output reads the input; an output that reads states only
+  /// breaks the cycle.
   bool feedthrough = true;
+  /// Output only, set by Block::set_output_reads: the inputs this output reads directly (sorted).
+  /// Unset: a feedthrough output reads every feedthrough input, any other output none.
+  std::optional<std::vector<int>> reads;
 };
 
 /// The numbers a block sees at one evaluation.
@@ -44,9 +51,17 @@ struct Eval {
   const double* x = nullptr;          ///< the block's states [num_states]
   const double* const* u = nullptr;   ///< u[k]: input port k, [width of port k]
   const double* p = nullptr;          ///< parameter values, in the order of the block's ParamSpecs
-  /// False in the first output pass, where only outputs declared without feedthrough need be
-  /// computed and inputs must not be read (they are not yet computed for this point).
+  /// Which inputs are computed for this point, per input port (null: all of them when
+  /// inputs_ready, none otherwise). Output passes call a block once per group of outputs that
+  /// read the same inputs, in dependency order; at each call the block sets (at least) the
+  /// outputs whose inputs are all ready (Block::output_ready) and reads no other input.
+  const unsigned char* ready = nullptr;
+  /// True when every input that some output reads is ready (the block's last output call,
+  /// and always for derivatives, quadratures and initial states). False in the call for the
+  /// state-only outputs of a block that also has feedthrough outputs.
   bool inputs_ready = true;
+
+  bool input_ready(int k) const { return ready ? ready[k] != 0 : inputs_ready; }
 
   /// Whether time has passed the breakpoint tb: true after it, and at it when the current
   /// segment started there.
@@ -81,11 +96,40 @@ class Block {
   virtual void initial_state(const Eval& e, double* x0) const {}
   virtual void initial_state_tangent(const Eval& e, const Seeds& s, DirView dx0) const {}
 
+  /// Inputs that output k reads directly, sorted: those given to set_output_reads, else every
+  /// feedthrough input for a feedthrough output, none for a state-only one.
+  std::vector<int> output_reads(int k) const {
+    const PortDecl& out = outputs_[k];
+    if (out.reads) return *out.reads;
+    std::vector<int> reads;
+    if (out.feedthrough)
+      for (int i = 0; i < static_cast<int>(inputs_.size()); ++i)
+        if (inputs_[i].feedthrough) reads.push_back(i);
+    return reads;
+  }
+  /// Whether output k is to be set in this evaluation: every input it reads is ready.
+  bool output_ready(const Eval& e, int k) const {
+    const PortDecl& out = outputs_[k];
+    if (out.reads) {
+      for (int i : *out.reads)
+        if (!e.input_ready(i)) return false;
+      return true;
+    }
+    if (!out.feedthrough) return true;
+    for (int i = 0; i < static_cast<int>(inputs_.size()); ++i)
+      if (inputs_[i].feedthrough && !e.input_ready(i)) return false;
+    return true;
+  }
+
   /// y = g(t, x, u, p) for every output port: y[k] has the width of output port k.
-  /// A block with outputs of both kinds is called twice per point: first with
-  /// e.inputs_ready == false (set the state-only outputs), then with all inputs ready.
+  /// A block whose outputs read different inputs is called once per group of outputs with the
+  /// same reads, in dependency order (see Eval::ready): it sets the outputs that are
+  /// output_ready(e, k) and may set them again, with the same values, in later calls. With the
+  /// default reads that is two calls for a block with outputs of both kinds: first with
+  /// e.inputs_ready == false (set the state-only outputs), then with the inputs ready.
   virtual void outputs(const Eval& e, double* const* y) const = 0;
-  /// dy = g_x dx + g_u du + g_p dp, for every output port and direction.
+  /// dy = g_x dx + g_u du + g_p dp, for every output port and direction; called like outputs
+  /// (the same ready inputs), reading the seeds of ready inputs only.
   virtual void outputs_tangent(const Eval& e, const Seeds& s, const DirView* dy) const = 0;
 
   /// xdot = f(t, x, u, p).
@@ -102,10 +146,18 @@ class Block {
 
  protected:
   void declare_input(std::string name, int width, std::string unit = "", bool feedthrough = true) {
-    inputs_.push_back({std::move(name), width, std::move(unit), feedthrough});
+    inputs_.push_back({std::move(name), width, std::move(unit), feedthrough, std::nullopt});
   }
   void declare_output(std::string name, int width, std::string unit = "", bool feedthrough = true) {
-    outputs_.push_back({std::move(name), width, std::move(unit), feedthrough});
+    outputs_.push_back({std::move(name), width, std::move(unit), feedthrough, std::nullopt});
+  }
+  /// Output `output` reads directly exactly the inputs `inputs` (indices of input ports; empty:
+  /// it reads states only). Overrides the output's feedthrough flag and the inputs' defaults.
+  void set_output_reads(int output, std::vector<int> inputs) {
+    std::sort(inputs.begin(), inputs.end());
+    inputs.erase(std::unique(inputs.begin(), inputs.end()), inputs.end());
+    outputs_[output].feedthrough = !inputs.empty();
+    outputs_[output].reads = std::move(inputs);
   }
   void declare_states(std::vector<std::string> names) {
     num_states_ = static_cast<int>(names.size());

@@ -57,6 +57,16 @@ struct Node {
   int quad_offset = 0;
 };
 
+/// One call of a block's outputs (and of their tangents) in the value and tangent passes.
+struct OutputStep {
+  int node = 0;
+  std::vector<int> outputs;          ///< the outputs first computable here: they read exactly
+  std::vector<int> reads;            ///< these inputs (sorted)
+  std::vector<unsigned char> ready;  ///< per input of the node: computed (read by this step or
+                                     ///< an earlier step of the node)
+  bool inputs_ready = true;          ///< every input some output of the node reads is ready
+};
+
 struct LoggedSignal {
   std::string name;  ///< block.port, with [i] appended per element when width > 1
   int offset = 0;    ///< in the signal array
@@ -71,9 +81,9 @@ class Diagram {
   std::vector<SceneParameter> parameters;
   std::vector<int> sensitivities;      ///< indices into parameters: the directions
   std::vector<Node> nodes;             ///< kept blocks, in scene order
-  /// Output evaluation: first the blocks with state-only outputs (inputs not ready), then, in
-  /// dependency order, the blocks with feedthrough outputs (a block may be in both).
-  std::vector<int> first_pass, second_pass;
+  /// Output evaluation, in dependency order: one step per group of a block's outputs that read
+  /// the same inputs (state-only outputs first).
+  std::vector<OutputStep> output_steps;
   std::vector<std::string> pruned;     ///< blocks no requested output needs
   std::vector<LoggedSignal> logged;    ///< one entry per scalar logged
   std::vector<int> objectives;         ///< node indices of requested objectives

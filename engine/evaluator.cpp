@@ -42,12 +42,10 @@ Evaluator::Evaluator(const Diagram& d, bool with_sensitivities)
   source_valid_.assign(nn, false);
   source_t_.assign(nn, 0.0);
   source_segment_.assign(nn, 0.0);
-  zero_tangent_.assign(nn, false);
-  signal_owner_.assign(d.num_signals, -1);
+  zero_tangent_.assign(d.num_signals, false);
   for (size_t i = 0; i < nn; ++i) {
     const Node& n = d.nodes[i];
     time_only_[i] = n.block->inputs().empty() && n.block->num_states() == 0;
-    for (int off : n.output_offset) signal_owner_[off] = static_cast<int>(i);
   }
   dy_.resize(max_ports);
   y_.resize(max_ports);
@@ -123,19 +121,20 @@ void Evaluator::outputs(double t, const double* x) {
   const int nx = d_.num_states;
   if (valid_ && t == last_t_ && (nx == 0 || std::memcmp(x, last_x_.data(), nx * sizeof(double)) == 0))
     return;
-  for (int pass = 0; pass < 2; ++pass)
-    for (int i : pass == 0 ? d_.first_pass : d_.second_pass) {
-      const Node& n = d_.nodes[i];
-      // Sources (no inputs, no states) depend on time alone: the Newton iterations of a step
-      // evaluate them at the same time again and again.
-      if (time_only_[i] && source_valid_[i] && source_t_[i] == t && source_segment_[i] == segment_start_)
-        continue;
-      for (size_t k = 0; k < n.output_offset.size(); ++k) y_[k] = sig_.data() + n.output_offset[k];
-      Eval e = eval_for(n, i, t, x);
-      e.inputs_ready = pass == 1;
-      call_block(n, [&] { n.block->outputs(e, y_.data()); });
-      if (time_only_[i]) source_valid_[i] = true, source_t_[i] = t, source_segment_[i] = segment_start_;
-    }
+  for (const OutputStep& step : d_.output_steps) {
+    const int i = step.node;
+    const Node& n = d_.nodes[i];
+    // Sources (no inputs, no states) depend on time alone: the Newton iterations of a step
+    // evaluate them at the same time again and again.
+    if (time_only_[i] && source_valid_[i] && source_t_[i] == t && source_segment_[i] == segment_start_)
+      continue;
+    for (size_t k = 0; k < n.output_offset.size(); ++k) y_[k] = sig_.data() + n.output_offset[k];
+    Eval e = eval_for(n, i, t, x);
+    e.ready = step.ready.data();
+    e.inputs_ready = step.inputs_ready;
+    call_block(n, [&] { n.block->outputs(e, y_.data()); });
+    if (time_only_[i]) source_valid_[i] = true, source_t_[i] = t, source_segment_[i] = segment_start_;
+  }
   valid_ = true;
   last_t_ = t;
   if (nx) std::memcpy(last_x_.data(), x, nx * sizeof(double));
@@ -164,28 +163,28 @@ void Evaluator::tangents(double t, const double* x, int nd, ConstDirView dx, boo
   outputs(t, x);
   const int ld = d_.num_signals;
   dsig_.resize(static_cast<size_t>(ld) * nd);
-  // Tangents are linear in the seeds: a block whose seeds are all zero (no state seeds, no
-  // parameter seeds, inputs from blocks with zero tangents) has zero output tangents, and is
-  // not called. Sources in a Jacobian pass are the common case.
-  for (int pass = 0; pass < 2; ++pass)
-    for (int i : pass == 0 ? d_.first_pass : d_.second_pass) {
-      const Node& n = d_.nodes[i];
-      const Seeds s = seeds_for(n, i, nd, dx, with_params);
-      bool zero = s.x.zero() && s.p.zero();
-      if (pass == 1)
-        for (int src : n.input_source) zero = zero && zero_tangent_[signal_owner_[src]];
-      for (size_t k = 0; k < n.output_offset.size(); ++k) dy_[k] = {dsig_.data() + n.output_offset[k], ld};
-      zero_tangent_[i] = zero;
-      if (zero) {
-        const auto& ports = n.block->outputs();
-        for (size_t k = 0; k < ports.size(); ++k)
-          for (int d = 0; d < nd; ++d) std::fill_n(dy_[k].data + d * ld, ports[k].width, 0.0);
-        continue;
-      }
-      Eval e = eval_for(n, i, t, x);
-      e.inputs_ready = pass == 1;
-      call_block(n, [&] { n.block->outputs_tangent(e, s, dy_.data()); });
+  // Tangents are linear in the seeds: the outputs of a step whose seeds are all zero (no state
+  // seeds, no parameter seeds, the inputs they read from outputs with zero tangents) have zero
+  // tangents, and the block is not called. Sources in a Jacobian pass are the common case.
+  for (const OutputStep& step : d_.output_steps) {
+    const int i = step.node;
+    const Node& n = d_.nodes[i];
+    const Seeds s = seeds_for(n, i, nd, dx, with_params);
+    bool zero = s.x.zero() && s.p.zero();
+    for (int k : step.reads) zero = zero && zero_tangent_[n.input_source[k]];
+    for (size_t k = 0; k < n.output_offset.size(); ++k) dy_[k] = {dsig_.data() + n.output_offset[k], ld};
+    for (int k : step.outputs) zero_tangent_[n.output_offset[k]] = zero;
+    if (zero) {
+      const auto& ports = n.block->outputs();
+      for (int k : step.outputs)
+        for (int d = 0; d < nd; ++d) std::fill_n(dy_[k].data + d * ld, ports[k].width, 0.0);
+      continue;
     }
+    Eval e = eval_for(n, i, t, x);
+    e.ready = step.ready.data();
+    e.inputs_ready = step.inputs_ready;
+    call_block(n, [&] { n.block->outputs_tangent(e, s, dy_.data()); });
+  }
   for (size_t i = 0; i < d_.nodes.size(); ++i) {
     const Node& n = d_.nodes[i];
     const bool states = dxdot.data && n.block->num_states() > 0;

@@ -65,8 +65,8 @@ class Evaluator {
   std::vector<bool> time_only_;        ///< node has neither inputs nor states: a source
   std::vector<bool> source_valid_;     ///< its outputs are those at source_t_
   std::vector<double> source_t_, source_segment_;
-  std::vector<bool> zero_tangent_;     ///< node's output tangents are zero in this tangent pass
-  std::vector<int> signal_owner_;      ///< node producing the signal at each output offset
+  std::vector<bool> zero_tangent_;     ///< per output port (at its signal offset): its tangents
+                                       ///< are zero in this tangent pass
   std::vector<const double*> u_;       ///< input pointers, per node concatenated
   std::vector<int> u_offset_;
   std::vector<double*> y_;             ///< output pointers, per node concatenated

@@ -70,67 +70,111 @@ void GraphBuilder::request_output(const std::string& text, int line) {
   requested_.emplace_back(resolve(trim(text), false, line), line);
 }
 
-bool GraphBuilder::has_feedthrough_output(int node) const {
-  const auto& outs = nodes_[node].block->outputs();
-  return std::any_of(outs.begin(), outs.end(), [](const PortDecl& p) { return p.feedthrough; });
-}
-
-std::vector<int> GraphBuilder::order_or_report_loop(const std::vector<bool>& keep) const {
-  // Kahn's algorithm over the blocks' feedthrough outputs: block t waits for block s when an
-  // output of s that reads inputs drives an input of t that some output of t reads. Outputs
-  // that read states only are computed first, in a pass of their own. Ties keep scene order.
+std::vector<OutputStep> GraphBuilder::schedule_or_report_loop(const std::vector<bool>& keep) const {
+  // One step per group of a block's outputs that read the same inputs; step t waits for step s
+  // when an output of s drives an input that the outputs of t read. Kahn's algorithm orders the
+  // steps; ties go to the state-only steps first (they wait for nothing), then scene order.
   const int n = static_cast<int>(nodes_.size());
-  std::vector<bool> late(n, false);
-  for (int i = 0; i < n; ++i) late[i] = keep[i] && has_feedthrough_output(i);
-  std::vector<int> indegree(n, 0);
-  std::vector<std::vector<int>> next(n);
+  std::vector<OutputStep> steps;
+  std::vector<std::vector<int>> step_of_output(n), steps_of_node(n);
+  std::vector<std::vector<int>> reads_any(n);  ///< inputs some output of the node reads
+  for (int state_only = 1; state_only >= 0; --state_only)
+    for (int i = 0; i < n; ++i) {
+      if (!keep[i]) continue;
+      const Block& b = *nodes_[i].block;
+      const int no = static_cast<int>(b.outputs().size());
+      if (state_only) step_of_output[i].assign(no, -1);
+      std::vector<std::vector<int>> groups;
+      for (int k = 0; k < no; ++k) {
+        std::vector<int> reads = b.output_reads(k);
+        if (state_only) reads_any[i].insert(reads_any[i].end(), reads.begin(), reads.end());
+        if (reads.empty() == (state_only == 1) && std::find(groups.begin(), groups.end(), reads) == groups.end())
+          groups.push_back(std::move(reads));
+      }
+      // fewer inputs first: a group read by a subset tends to be ready sooner
+      std::stable_sort(groups.begin(), groups.end(),
+                       [](const auto& l, const auto& r) { return l.size() < r.size(); });
+      for (auto& reads : groups) {
+        OutputStep step;
+        step.node = i;
+        for (int k = 0; k < no; ++k)
+          if (b.output_reads(k) == reads) {
+            step.outputs.push_back(k);
+            step_of_output[i][k] = static_cast<int>(steps.size());
+          }
+        step.reads = std::move(reads);
+        steps_of_node[i].push_back(static_cast<int>(steps.size()));
+        steps.push_back(std::move(step));
+      }
+    }
+
+  const int ns = static_cast<int>(steps.size());
+  std::vector<int> indegree(ns, 0);
+  std::vector<std::vector<std::pair<int, int>>> next(ns);  // (step, line of the connection)
   for (const Edge& e : edges_) {
-    if (!late[e.src.node] || !late[e.dst.node]) continue;
-    if (!nodes_[e.src.node].block->outputs()[e.src.port].feedthrough) continue;
-    if (!nodes_[e.dst.node].block->inputs()[e.dst.port].feedthrough) continue;
-    next[e.src.node].push_back(e.dst.node);
-    ++indegree[e.dst.node];
+    if (!keep[e.src.node] || !keep[e.dst.node]) continue;
+    const int from = step_of_output[e.src.node][e.src.port];
+    for (int to : steps_of_node[e.dst.node]) {
+      const auto& reads = steps[to].reads;
+      if (!std::binary_search(reads.begin(), reads.end(), e.dst.port)) continue;
+      next[from].emplace_back(to, e.line);
+      ++indegree[to];
+    }
   }
   std::priority_queue<int, std::vector<int>, std::greater<int>> ready;
-  for (int i = 0; i < n; ++i)
-    if (late[i] && indegree[i] == 0) ready.push(i);
+  for (int s = 0; s < ns; ++s)
+    if (indegree[s] == 0) ready.push(s);
   std::vector<int> order;
   while (!ready.empty()) {
-    const int i = ready.top();
+    const int s = ready.top();
     ready.pop();
-    order.push_back(i);
-    for (int j : next[i])
-      if (--indegree[j] == 0) ready.push(j);
+    order.push_back(s);
+    for (const auto& [t, line] : next[s])
+      if (--indegree[t] == 0) ready.push(t);
   }
-  const int count = static_cast<int>(std::count(late.begin(), late.end(), true));
-  if (static_cast<int>(order.size()) == count) return order;
+  if (static_cast<int>(order.size()) == ns) {
+    // The inputs ready at each step: those its block's earlier steps and itself read.
+    std::vector<OutputStep> ordered;
+    std::vector<std::vector<unsigned char>> mask(n);
+    for (int s : order) {
+      OutputStep& step = steps[s];
+      auto& m = mask[step.node];
+      m.resize(nodes_[step.node].block->inputs().size(), 0);
+      for (int k : step.reads) m[k] = 1;
+      step.ready = m;
+      step.inputs_ready = std::all_of(reads_any[step.node].begin(), reads_any[step.node].end(),
+                                      [&](int k) { return m[k] != 0; });
+      ordered.push_back(std::move(step));
+    }
+    return ordered;
+  }
 
-  // Some blocks remain, each with a remaining predecessor: walk predecessors until one repeats.
-  std::vector<std::vector<int>> prev(n);
-  for (int i = 0; i < n; ++i)
-    for (int j : next[i]) prev[j].push_back(i);
+  // Some steps remain, each with a remaining predecessor: walk predecessors until one repeats.
+  std::vector<std::vector<std::pair<int, int>>> prev(ns);
+  for (int s = 0; s < ns; ++s)
+    for (const auto& [t, line] : next[s]) prev[t].emplace_back(s, line);
   int at = -1;
-  for (int i = 0; i < n && at < 0; ++i)
-    if (late[i] && indegree[i] > 0) at = i;
+  for (int s = 0; s < ns && at < 0; ++s)
+    if (indegree[s] > 0) at = s;
   std::vector<int> path;
-  std::vector<int> pos(n, -1);
+  std::vector<int> pos(ns, -1);
   while (pos[at] < 0) {
     pos[at] = static_cast<int>(path.size());
     path.push_back(at);
-    for (int j : prev[at])
-      if (indegree[j] > 0) { at = j; break; }
+    for (const auto& [s, line] : prev[at])
+      if (indegree[s] > 0) { at = s; break; }
   }
   std::vector<int> cycle(path.begin() + pos[at], path.end());
   std::reverse(cycle.begin(), cycle.end());  // now in signal-flow order
   std::string names;
   int line = 0;
   for (size_t k = 0; k < cycle.size(); ++k) {
-    names += nodes_[cycle[k]].name + " -> ";
+    names += nodes_[steps[cycle[k]].node].name + " -> ";
     const int to = cycle[(k + 1) % cycle.size()];
-    for (const Edge& e : edges_)
-      if (e.src.node == cycle[k] && e.dst.node == to && (line == 0 || e.line < line)) line = e.line;
+    for (const auto& [t, l] : next[cycle[k]])
+      if (t == to && (line == 0 || l < line)) line = l;
   }
-  names += nodes_[cycle.front()].name;
+  names += nodes_[steps[cycle.front()].node].name;
   throw InputError(file_, line, "connections",
                    "algebraic loop (a cycle through direct feedthrough, no state to break it): " + names);
 }
@@ -163,8 +207,8 @@ void GraphBuilder::build(Diagram& d) {
       if (e.dst.node == i) stack.push_back(e.src.node);
   }
   // Loops are errors even in pruned parts of the scene: check over all blocks first.
-  order_or_report_loop(std::vector<bool>(n, true));
-  const std::vector<int> second = order_or_report_loop(keep);
+  schedule_or_report_loop(std::vector<bool>(n, true));
+  std::vector<OutputStep> steps = schedule_or_report_loop(keep);
 
   for (int i = 0; i < n; ++i)
     if (!keep[i]) d.pruned.push_back(nodes_[i].name);
@@ -184,12 +228,12 @@ void GraphBuilder::build(Diagram& d) {
     }
     node.input_source.assign(node.block->inputs().size(), -1);
     new_index[i] = static_cast<int>(d.nodes.size());
-    const auto& outs = node.block->outputs();
-    if (std::any_of(outs.begin(), outs.end(), [](const PortDecl& p) { return !p.feedthrough; }))
-      d.first_pass.push_back(new_index[i]);
     d.nodes.push_back(std::move(node));
   }
-  for (int i : second) d.second_pass.push_back(new_index[i]);
+  for (OutputStep& step : steps) {
+    step.node = new_index[step.node];
+    d.output_steps.push_back(std::move(step));
+  }
   for (const Edge& e : edges_) {
     if (new_index[e.dst.node] < 0) continue;
     Node& dst = d.nodes[new_index[e.dst.node]];

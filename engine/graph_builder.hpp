@@ -36,9 +36,9 @@ class GraphBuilder {
     int line = 0;
   };
   PortRef resolve(const std::string& text, bool input, int line) const;
-  bool has_feedthrough_output(int node) const;
-  /// Order of the blocks with feedthrough outputs; throws naming the blocks of a loop.
-  std::vector<int> order_or_report_loop(const std::vector<bool>& keep) const;
+  /// The output steps of the kept blocks in evaluation order (node: index into nodes_); throws
+  /// naming the blocks of an algebraic loop.
+  std::vector<OutputStep> schedule_or_report_loop(const std::vector<bool>& keep) const;
 
   std::string file_;
   std::vector<Node> nodes_;
