@@ -19,7 +19,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 enum Param {
   kRadius, kMu, kFzNominal, kLoadFriction, kBx, kCx, kEx, kBy, kCy, kEy, kBxAlpha, kByKappa,
-  kRelaxX, kRelaxY, kTrail, kTrailDecay, kSpeedFloor
+  kRelaxX, kRelaxY, kTrail, kTrailDecay, kSpeedFloor, kCorneringLoad
 };
 enum Input { kFz, kVx, kVy, kOmega };
 enum State { kKappa, kAlpha };
@@ -40,6 +40,25 @@ struct MagicFormula {
     const double dv = du - de * (u - std::atan(u)) - e * (du - du / (1 + u * u));
     const double dw = dv / (1 + v * v);
     return cos_cw * (dc * w + c * dw);
+  }
+};
+
+/// Lateral stiffness factor at load Fz: B_y(Fz) = By (k^2 + 1) / ((k^2 + f^2) (1 + pD2 (f - 1))),
+/// f = Fz / Fz0, k = cornering_load, so that the cornering stiffness B_y Cy mu Fz equals
+/// By Cy mu0 Fz0 sin(2 atan(f / k)) / sin(2 atan(1 / k)) (the MF 5.2 law of pKy1, pKy2): it
+/// is By Cy mu0 Fz0 at Fz0, peaks at Fz = k Fz0, and grows less than the load (so a load
+/// transfer across an axle costs the axle cornering stiffness). Returns B and its tangent.
+struct LateralStiffness {
+  double b;
+  LateralStiffness(const double* p, double fz) {
+    const double f = fz / p[kFzNominal], k = p[kCorneringLoad];
+    b = p[kBy] * (k * k + 1) / ((k * k + f * f) * (1 + p[kLoadFriction] * (f - 1)));
+  }
+  double tangent(const double* p, double fz, double dfz, double dby, double dfz0, double dpd2, double dk) const {
+    const double fz0 = p[kFzNominal], f = fz / fz0, k = p[kCorneringLoad], m = 1 + p[kLoadFriction] * (f - 1);
+    const double df = dfz / fz0 - f * dfz0 / fz0;
+    const double dm = dpd2 * (f - 1) + p[kLoadFriction] * df;
+    return b * (dby / p[kBy] + 2 * k * dk / (k * k + 1) - 2 * (k * dk + f * df) / (k * k + f * f) - dm / m);
   }
 };
 
@@ -71,7 +90,7 @@ class TyreMf : public Block {
   }
 
   /// mu(Fz) = mu0 (1 + pD2 (Fz - Fz0) / Fz0); Fx = mu Fz MFx(kappa) G(alpha);
-  /// Fy = mu Fz MFy(alpha) G(kappa); Mz = -t(alpha) Fy, t = t0 / sqrt(1 + (Bt alpha)^2).
+  /// Fy = mu Fz MFy(alpha; B_y(Fz)) G(kappa); Mz = -t(alpha) Fy, t = t0 / sqrt(1 + (Bt alpha)^2).
   void outputs(const Eval& e, double* const* y) const override {
     const double* p = e.p;
     const double kappa = e.x[kKappa], alpha = e.x[kAlpha];
@@ -80,7 +99,8 @@ class TyreMf : public Block {
     if (!e.inputs_ready) return;
     const double fz = e.u[kFz][0];
     const double mu = p[kMu] * (1 + p[kLoadFriction] * (fz - p[kFzNominal]) / p[kFzNominal]);
-    const MagicFormula mx(kappa, p[kBx], p[kCx], p[kEx]), my(alpha, p[kBy], p[kCy], p[kEy]);
+    const LateralStiffness by(p, fz);
+    const MagicFormula mx(kappa, p[kBx], p[kCx], p[kEx]), my(alpha, by.b, p[kCy], p[kEy]);
     const double fy = mu * fz * my.y * weight(p[kByKappa], kappa);
     y[kFx][0] = mu * fz * mx.y * weight(p[kBxAlpha], alpha);
     y[kFy][0] = fy;
@@ -97,7 +117,8 @@ class TyreMf : public Block {
     const double fz = e.u[kFz][0], fz0 = p[kFzNominal];
     const double load = (fz - fz0) / fz0;
     const double mu = p[kMu] * (1 + p[kLoadFriction] * load);
-    const MagicFormula mx(kappa, p[kBx], p[kCx], p[kEx]), my(alpha, p[kBy], p[kCy], p[kEy]);
+    const LateralStiffness by(p, fz);
+    const MagicFormula mx(kappa, p[kBx], p[kCx], p[kEx]), my(alpha, by.b, p[kCy], p[kEy]);
     const double gx = weight(p[kBxAlpha], alpha), gy = weight(p[kByKappa], kappa), gt = weight(p[kTrailDecay], alpha);
     const double fy = mu * fz * my.y * gy;
     for (int d = 0; d < s.directions; ++d) {
@@ -107,7 +128,8 @@ class TyreMf : public Block {
       const double d_mu = dp(kMu) * (1 + p[kLoadFriction] * load) + p[kMu] * (dp(kLoadFriction) * load + p[kLoadFriction] * d_load);
       const double d_mufz = d_mu * fz + mu * dfz;
       const double d_mx = mx.tangent(kappa, p[kBx], p[kCx], p[kEx], dk, dp(kBx), dp(kCx), dp(kEx));
-      const double d_my = my.tangent(alpha, p[kBy], p[kCy], p[kEy], da, dp(kBy), dp(kCy), dp(kEy));
+      const double d_by = by.tangent(p, fz, dfz, dp(kBy), dp(kFzNominal), dp(kLoadFriction), dp(kCorneringLoad));
+      const double d_my = my.tangent(alpha, by.b, p[kCy], p[kEy], da, d_by, dp(kCy), dp(kEy));
       const double d_gx = weight_tangent(p[kBxAlpha], alpha, dp(kBxAlpha), da);
       const double d_gy = weight_tangent(p[kByKappa], kappa, dp(kByKappa), dk);
       const double d_gt = weight_tangent(p[kTrailDecay], alpha, dp(kTrailDecay), da);
@@ -169,7 +191,8 @@ const engine::BlockRegistration tyre_mf({
      {"relaxation_y", "m", 0.45, false, 1e-4, kInf, "lateral relaxation length"},
      {"trail", "m", 0.03, false, 0.0, kInf, "pneumatic trail at zero slip angle"},
      {"trail_decay", "", 8.0, false, 0.0, kInf, "decay of the trail with slip angle"},
-     {"speed_floor", "m/s", 0.5, false, 1e-6, kInf, "speed below which slips are rounded (V = sqrt(vx^2 + v0^2))"}},
+     {"speed_floor", "m/s", 0.5, false, 1e-6, kInf, "speed below which slips are rounded (V = sqrt(vx^2 + v0^2))"},
+     {"cornering_load", "", 2.0, false, 1e-3, kInf, "pKy2: load (in units of fz_nominal) at which the cornering stiffness peaks"}},
     {},
     [](const engine::BlockSettings&) -> std::unique_ptr<Block> { return std::make_unique<TyreMf>(); }});
 

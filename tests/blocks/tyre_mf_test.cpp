@@ -51,7 +51,16 @@ TEST(TyreMf, PureAndCombinedSlip) {
   // Cornering stiffness B C D at small slip; load dependence of friction (pD2 = -0.1).
   const double h = 1e-6;
   EXPECT_NEAR(forces(*b, p, 4000, 0, h)[1] / h, 10 * 1.9 * 4000, 1e-3 * 10 * 1.9 * 4000);
-  EXPECT_NEAR(forces(*b, p, 8000, 0, 0.3)[1], 8000 * 0.9 * magic(0.3, 10, 1.9, 0.97), 1e-9);
+  // At twice the nominal load: friction 0.9 (pD2), and the cornering stiffness of the MF 5.2
+  // law By Cy mu0 Fz0 sin(2 atan(Fz / (pKy2 Fz0))) / sin(2 atan(1 / pKy2)), pKy2 = 2, which is
+  // 76 kN/rad * 1 / 0.8 = 95 kN/rad (not twice 76): load transfer costs an axle grip.
+  const double k8000 = 10 * 1.9 * 4000 * std::sin(2 * std::atan(1.0)) / std::sin(2 * std::atan(0.5));
+  EXPECT_NEAR(k8000, 95000.0, 1e-6);
+  EXPECT_NEAR(forces(*b, p, 8000, 0, h)[1] / h, k8000, 1e-3 * k8000);
+  const double b8000 = k8000 / (1.9 * 0.9 * 8000);
+  EXPECT_NEAR(forces(*b, p, 8000, 0, 0.3)[1], 8000 * 0.9 * magic(0.3, b8000, 1.9, 0.97), 1e-9);
+  // Peak friction force still mu Fz at any load (the stiffness law changes only the shape).
+  EXPECT_NEAR(forces(*b, p, 8000, 0, 1.2)[1], 8000 * 0.9 * magic(1.2, b8000, 1.9, 0.97), 1e-9);
   // Combined slip reduces both forces; aligning torque opposes Fy's moment sense (self-aligning).
   const auto pure = forces(*b, p, 4000, 0, 0.05), combined = forces(*b, p, 4000, 0.1, 0.05);
   EXPECT_LT(std::fabs(combined[1]), std::fabs(pure[1]));
