@@ -1,5 +1,5 @@
 // steering: the rack displacement a manoeuvre commands: step, ramp-and-hold, sine, or a CSV
-// column. Outputs `rack` [m] (positive steers left) and `rack_rate` [m/s]; every corner of the
+// column. Outputs `rack` [m] (positive: rack to the left, +y; which way the wheels turn depends on the linkage) and `rack_rate` [m/s]; every corner of the
 // law is a breakpoint, and branches are chosen with Eval::reached().
 #include <algorithm>
 #include <cmath>
@@ -109,7 +109,7 @@ void read_table(const BlockSettings& s, std::vector<double>& t, std::vector<doub
 
 const engine::BlockRegistration steering({
     "steering", "manoeuvres",
-    "Rack displacement (positive steers left): step, ramp_hold, sine from `start`, or a CSV column [m] against time.",
+    "Rack displacement (positive: rack to the left, +y): step, ramp_hold, sine from `start`, or a CSV column [m] against time.",
     {{"amplitude", "m", 0.01, false, -kInf, kInf, "rack displacement of the step, hold or sine"},
      {"start", "s", 1.0, false, -kInf, kInf, "time the manoeuvre starts", false},
      {"ramp_time", "s", 0.5, false, 1e-9, kInf, "ramp_hold: duration of the ramp", false},
