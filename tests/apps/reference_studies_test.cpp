@@ -36,8 +36,14 @@ std::string replace(std::string text, const std::string& from, const std::string
   return text;
 }
 
-std::string tight(const std::string& scene) {
-  return replace(scene, "rtol: 1.0e-6, atol: 1.0e-8", "rtol: 1.0e-10, atol: 1.0e-12");
+/// The scene at rtol 1e-10 (1e-12 where asked). Central differences need the tighter one on the
+/// quarter car: at 1e-10 the damper power's difference quotient for the pipe length converges
+/// (as the step shrinks) to a value 2.5e-4 off, the derivative of the adaptive solver's
+/// tolerance-sized error with the parameter; at 1e-12 it agrees to 1e-5 with the exact value,
+/// which itself moves by less than 1e-6 between rtol 1e-8 and 1e-11.
+std::string tight(const std::string& scene, bool tighter = false) {
+  return replace(scene, "rtol: 1.0e-6, atol: 1.0e-8",
+                 tighter ? "rtol: 1.0e-12, atol: 1.0e-14" : "rtol: 1.0e-10, atol: 1.0e-12");
 }
 
 using Values = std::map<std::string, double>;
@@ -78,7 +84,8 @@ TEST(ReferenceStudies, CorneringSensitivityMatchesCentralDifferences) {
 }
 
 TEST(ReferenceStudies, QuarterCarSensitivitiesMatchCentralDifferences) {
-  const auto path = write_scene("quarter_car_tight.yaml", tight(read_scenario("quarter_car_cdc.yaml")));
+  if (DYDP_SANITIZED) GTEST_SKIP() << "minutes under the sanitizers; run in the release build";
+  const auto path = write_scene("quarter_car_tight.yaml", tight(read_scenario("quarter_car_cdc.yaml"), true));
   check_against_central_differences(path, "valve_current", 0.8, 2e-3, 1e-4);
   check_against_central_differences(path, "pipe_length", 0.1, 2e-4, 1e-4);
 }
