@@ -48,7 +48,7 @@ class Sum : public Block {
       sign_.push_back(signs[k] == '-' ? -1.0 : 1.0);
       declare_input("in" + std::to_string(k + 1), w_);
     }
-    declare_output("y", w_);
+    declare_output("y", w_, engine::kUnitOfFirstInput);
   }
   void outputs(const Eval& e, double* const* y) const override {
     for (int i = 0; i < w_; ++i) {
@@ -192,7 +192,7 @@ class Demux : public Block {
  public:
   Demux(int width, std::vector<int> indices) : index_(std::move(indices)) {
     declare_input("u", width);
-    declare_output("y", static_cast<int>(index_.size()));
+    declare_output("y", static_cast<int>(index_.size()), engine::kUnitOfFirstInput);
   }
   void outputs(const Eval& e, double* const* y) const override {
     for (size_t k = 0; k < index_.size(); ++k) y[0][k] = e.u[0][index_[k]];
@@ -211,7 +211,7 @@ class Mux : public Block {
  public:
   explicit Mux(int n) : n_(n) {
     for (int k = 0; k < n; ++k) declare_input("in" + std::to_string(k + 1), 1);
-    declare_output("y", n);
+    declare_output("y", n, engine::kUnitOfFirstInput);
   }
   void outputs(const Eval& e, double* const* y) const override {
     for (int k = 0; k < n_; ++k) y[0][k] = e.u[k][0];

@@ -60,7 +60,7 @@ class Multibody : public Block {
     set_output_reads(0, driven_motion);
     set_output_reads(1, driven_motion);
     for (int s = 0; s < g_.sensor_count; ++s) {
-      declare_output(g_.sensor_ports[s], g_.sensor_widths[s], "");
+      declare_output(g_.sensor_ports[s], g_.sensor_widths[s], g_.sensor_units ? g_.sensor_units[s] : "");
       if (!g_.sensor_reads_acceleration[s]) set_output_reads(3 + s, driven_motion);
     }
     std::vector<std::string> states;

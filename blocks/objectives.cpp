@@ -64,6 +64,10 @@ class Integral : public ObjectiveBlock {
  public:
   enum class Kind { integral, mean, rms };
   Integral(Window w, Kind kind) : ObjectiveBlock(w, 1), kind_(kind) {}
+  std::string unit(const std::string& input) const override {
+    if (kind_ != Kind::integral) return input;
+    return input.empty() ? "s" : input + " s";
+  }
 
   void quadratures(const Eval& e, double* qdot) const override {
     const double u = e.u[0][0];

@@ -27,6 +27,7 @@ class SlipAngle : public Block, public engine::Objective {
     declare_input("vy", 1, "m/s", false);
     declare_quadratures(1);
   }
+  std::string unit(const std::string&) const override { return "rad"; }
   bool inside(const Eval& e) const { return e.reached(from_) && !e.reached(to_); }
   void outputs(const Eval&, double* const*) const override {}
   void outputs_tangent(const Eval&, const Seeds&, const DirView*) const override {}

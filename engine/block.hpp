@@ -26,11 +26,15 @@ struct DirView {
   operator ConstDirView() const { return {data, ld}; }
 };
 
+/// Unit of an output that carries its first input's unit (demux, sum, lag, ...): the engine
+/// resolves it from whatever drives that input (Diagram::signal_unit).
+inline constexpr const char* kUnitOfFirstInput = "=";
+
 /// A port as a block instance declares it.
 struct PortDecl {
   std::string name;
   int width = 1;
-  std::string unit;
+  std::string unit;  ///< SI unit, "" when unknown or dimensionless, kUnitOfFirstInput
   /// Input: the outputs that do not list their inputs (`reads`) read this input directly
   /// (without a state in between).
   /// Output: this output reads some input directly. Algebraic loops are cycles through

@@ -92,6 +92,9 @@ class Diagram {
   int num_quadratures = 0;
 
   int find_parameter(const std::string& name) const;
+  /// Unit of the signal at `offset` (an output's element), following outputs that carry their
+  /// first input's unit upstream; "" when unknown.
+  std::string signal_unit(int offset) const;
   /// Sets a scene parameter and every block parameter it drives; checks the bounds of both
   /// (the scene parameter's range only with check_range: finite differences step past it).
   void set_parameter(int index, double value, bool check_range = true);

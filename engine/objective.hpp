@@ -2,6 +2,7 @@
 // d(psi)/dp for every sensitivity direction, from its quadratures and, where needed, samples.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "engine/block.hpp"
@@ -22,6 +23,8 @@ struct ObjectiveSamples {
 class Objective {
  public:
   virtual ~Objective() = default;
+  /// Unit of psi given the unit of the first input ("" when unknown).
+  virtual std::string unit(const std::string& input_unit) const { return input_unit; }
   /// Whether the objective needs its input sampled on the output grid (max, final value).
   virtual bool needs_samples() const { return false; }
   /// psi from the quadratures q at the end of the run; dpsi[d] from their seeds dq(., d).

@@ -56,7 +56,7 @@ std::string objectives_json(const RunResult& r) {
   for (const auto& o : r.objectives) {
     nlohmann::ordered_json sens = nlohmann::ordered_json::object();
     for (size_t d = 0; d < r.sensitivity_names.size(); ++d) sens[r.sensitivity_names[d]] = o.sensitivity[d];
-    objectives[o.name] = {{"value", o.value}, {"sensitivity", sens}};
+    objectives[o.name] = {{"value", o.value}, {"unit", o.unit}, {"sensitivity", sens}};
   }
   return nlohmann::ordered_json{{"objectives", objectives}}.dump(2) + "\n";
 }

@@ -41,9 +41,13 @@ struct RunStats {
 
 struct ObjectiveResult {
   std::string name;
+  std::string unit;                 ///< of value (sensitivities: unit per unit of the parameter)
   double value = 0.0;
   std::vector<double> sensitivity;  ///< one per sensitivity direction
 };
+
+/// "a / b" for the unit of a derivative da/db ("" when both are unknown).
+std::string unit_per(const std::string& a, const std::string& b);
 
 struct RunResult {
   std::vector<std::string> signal_names;       ///< logged scalars

@@ -289,6 +289,23 @@ Diagram load_scene(const std::string& path,
   return d;
 }
 
+std::string Diagram::signal_unit(int offset) const {
+  for (int hops = 0; hops < 64; ++hops) {
+    const Node* from = nullptr;
+    int port = -1;
+    for (const Node& n : nodes)
+      for (size_t k = 0; k < n.output_offset.size(); ++k)
+        if (offset >= n.output_offset[k] && offset < n.output_offset[k] + n.block->outputs()[k].width)
+          from = &n, port = static_cast<int>(k);
+    if (!from) return "";
+    const std::string& unit = from->block->outputs()[port].unit;
+    if (unit != kUnitOfFirstInput) return unit;
+    if (from->input_source.empty()) return "";
+    offset = from->input_source[0];
+  }
+  return "";
+}
+
 int Diagram::find_parameter(const std::string& name) const {
   for (size_t i = 0; i < parameters.size(); ++i)
     if (parameters[i].name == name) return static_cast<int>(i);

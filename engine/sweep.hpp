@@ -33,6 +33,7 @@ struct SweepPoint {
 struct SweepResult {
   std::string parameter, unit;
   std::vector<std::string> objectives;
+  std::vector<std::string> objective_units;  ///< unit of each objective's psi
   std::vector<double> fd_steps;
   std::vector<SweepPoint> points;
 };

@@ -6,5 +6,5 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 cmake --preset release >/dev/null
 cmake --build --preset release --target dydp
-scene=${1:-scenarios/quarter_car_cdc.yaml}
+scene=${1:-scenarios/fourposter_comfort.yaml}
 ./build/release/apps/dydp/dydp run "$scene" --out out --report

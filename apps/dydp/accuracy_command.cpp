@@ -34,10 +34,16 @@ std::string accuracy_csv(const engine::AccuracyReport& r) {
 int accuracy_command(const AccuracyArgs& args) {
   engine::Diagram d = engine::load_scene(args.scene, parse_sets(args.sets));
   engine::AccuracySpec spec;
+  spec.methods = args.methods;
   std::cerr << "accuracy: reference run (bdf, rtol " << spec.reference_rtol << ") and its check...\n";
   const engine::AccuracyReport r = engine::accuracy_study(d, spec, [](const engine::AccuracyRow& row) {
     std::cerr << "  " << std::left << std::setw(7) << row.method << std::setw(10) << row.setting
-              << (row.ok ? "" : "failed") << "\n";
+              << std::right << std::setprecision(3);
+    if (row.ok)
+      std::cerr << std::setw(8) << row.stats.cpu_seconds << " CPU s, signal error " << std::setw(9) << row.signal_error
+                << ", sensitivity error " << std::setw(9) << row.sensitivity_error << "\n";
+    else
+      std::cerr << "failed: " << row.failure << "\n";
   });
 
   std::filesystem::create_directories(args.out);

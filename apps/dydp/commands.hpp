@@ -31,6 +31,7 @@ struct AccuracyArgs {
   std::string out = "out";
   std::vector<std::string> sets;
   double target = 1e-4;  ///< requested relative accuracy for the "cheapest setting" line
+  std::vector<std::string> methods = {"bdf", "adams", "rk4", "sdirk2"};
 };
 
 struct ReplayArgs {

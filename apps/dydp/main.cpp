@@ -38,6 +38,10 @@ int main(int argc, char** argv) {
   accuracy->add_option("--out", accuracy_args.out, "output folder")->capture_default_str();
   accuracy->add_option("--set", accuracy_args.sets, "override a scene parameter: NAME=VALUE");
   accuracy->add_option("--target", accuracy_args.target, "accuracy for the cheapest-setting line")->capture_default_str();
+  accuracy->add_option("--methods", accuracy_args.methods, "methods of the ladder (bdf adams rk4 sdirk2)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"bdf", "adams", "rk4", "sdirk2"}))
+      ->capture_default_str();
 
   dydp::apps::ReplayArgs replay_args;
   CLI::App* replay = app.add_subcommand("replay", "Replay recorded test-bench input through a scene");

@@ -46,13 +46,19 @@ void write_report(const std::string& dir, const engine::Diagram& d, const engine
   if (!r.objectives.empty()) {
     md << "\n## Objectives\n\nNormalised sensitivity: (p / psi) d(psi)/dp, the % change of psi for "
           "1 % change of p.\n\n| objective | psi | parameter | d(psi)/dp | normalised |\n|---|---|---|---|---|\n";
+    const auto with_unit = [](double v, const std::string& u) {
+      std::ostringstream s;
+      s << std::setprecision(6) << v << (u.empty() ? "" : " " + u);
+      return s.str();
+    };
     for (const auto& o : r.objectives) {
-      if (ns == 0) md << "| " << o.name << " | " << o.value << " | | | |\n";
+      if (ns == 0) md << "| " << o.name << " | " << with_unit(o.value, o.unit) << " | | | |\n";
       for (int k = 0; k < ns; ++k) {
-        const double p = d.parameters[d.find_parameter(r.sensitivity_names[k])].value;
-        md << "| " << o.name << " | " << o.value << " | " << r.sensitivity_names[k] << " | "
-           << o.sensitivity[k] << " | " << (o.value != 0 ? p / o.value * o.sensitivity[k] : 0.0)
-           << " |\n";
+        const auto& sp = d.parameters[d.find_parameter(r.sensitivity_names[k])];
+        md << "| " << o.name << " | " << with_unit(o.value, o.unit) << " | " << r.sensitivity_names[k]
+           << (sp.unit.empty() ? "" : " [" + sp.unit + "]") << " | "
+           << with_unit(o.sensitivity[k], engine::unit_per(o.unit, sp.unit)) << " | "
+           << (o.value != 0 ? sp.value / o.value * o.sensitivity[k] : 0.0) << " |\n";
       }
     }
   }

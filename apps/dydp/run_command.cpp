@@ -49,9 +49,12 @@ int run_command(const RunArgs& args) {
             << r.stats.simulated_seconds << " s simulated (" << std::setprecision(4)
             << r.stats.realtime_factor << "x real time)\n";
   for (const auto& o : r.objectives) {
-    std::cout << "  " << o.name << " = " << std::setprecision(6) << o.value;
-    for (size_t k = 0; k < o.sensitivity.size(); ++k)
-      std::cout << "   d/d" << r.sensitivity_names[k] << " = " << o.sensitivity[k];
+    std::cout << "  " << o.name << " = " << std::setprecision(6) << o.value << (o.unit.empty() ? "" : " " + o.unit);
+    for (size_t k = 0; k < o.sensitivity.size(); ++k) {
+      const std::string& punit = d.parameters[d.find_parameter(r.sensitivity_names[k])].unit;
+      const std::string u = engine::unit_per(o.unit, punit);
+      std::cout << "   d/d" << r.sensitivity_names[k] << " = " << o.sensitivity[k] << (u.empty() ? "" : " " + u);
+    }
     std::cout << "\n";
   }
   if (!d.pruned.empty()) {

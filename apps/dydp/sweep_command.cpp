@@ -73,6 +73,7 @@ int sweep_command(const SweepArgs& args) {
   j["parameter"] = r.parameter;
   j["unit"] = r.unit;
   j["objectives"] = r.objectives;
+  j["objective_units"] = r.objective_units;
   j["fd_steps"] = r.fd_steps;
   for (const auto& pt : r.points) {
     nlohmann::ordered_json p = {{"p", pt.p}, {"cpu_seconds", pt.stats.cpu_seconds}};
@@ -90,7 +91,8 @@ int sweep_command(const SweepArgs& args) {
 
   std::cout << std::setprecision(6);
   for (size_t o = 0; o < r.objectives.size(); ++o) {
-    std::cout << r.objectives[o] << " against " << r.parameter << (r.unit.empty() ? "" : " [" + r.unit + "]") << ":\n";
+    std::cout << r.objectives[o] << (r.objective_units[o].empty() ? "" : " [" + r.objective_units[o] + "]")
+              << " against " << r.parameter << (r.unit.empty() ? "" : " [" + r.unit + "]") << ":\n";
     std::cout << "  " << std::setw(12) << "p" << std::setw(14) << "psi" << std::setw(14) << "dpsi/dp"
               << std::setw(14) << "% per %";
     if (args.delta > 0) std::cout << std::setw(14) << ("for +" + std::to_string(args.delta).substr(0, 6));

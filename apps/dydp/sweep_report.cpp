@@ -27,7 +27,10 @@ void write_sweep_report(const std::string& dir, const std::string& scene, const 
   md << r.points.size() << " runs over " << P << " in [" << r.points.front().p << ", " << r.points.back().p
      << "]" << unit << ", each with the exact sensitivity d(psi)/d(" << P << ") (direct method).\n\n";
   for (int o = 0; o < no; ++o) {
-    md << "## " << r.objectives[o] << "\n\n| " << P << unit << " | psi | d(psi)/dp | % per % |";
+    const std::string& ou = r.objective_units[o];
+    const std::string du = engine::unit_per(ou, r.unit);
+    md << "## " << r.objectives[o] << "\n\n| " << P << unit << " | psi" << (ou.empty() ? "" : " [" + ou + "]")
+       << " | d(psi)/dp" << (du.empty() ? "" : " [" + du + "]") << " | % per % |";
     if (delta > 0) md << " change for +" << delta << " |";
     md << "\n|---|---|---|---|" << (delta > 0 ? "---|" : "") << "\n";
     for (const auto& pt : r.points) {
@@ -59,10 +62,12 @@ void write_sweep_report(const std::string& dir, const std::string& scene, const 
     write_data(dir + "/plots/sweep_" + name + ".dat", data.str());
     gp << "set output '" << dir << "/plots/sweep_" << name << ".png'\n"
        << "set multiplot layout 2,1 title '" << r.objectives[o] << " against " << P << "'\n"
-       << "set xlabel '" << P << unit << "'\nset ylabel 'psi'\n"
+       << "set xlabel '" << P << unit << "'\nset ylabel '" << r.objectives[o]
+       << (r.objective_units[o].empty() ? "" : " [" + r.objective_units[o] + "]") << "'\n"
        << "plot '" << dir << "/plots/sweep_" << name << ".dat' using 1:2 with linespoints pt 7 title 'psi', "
        << "'' using ($1-$4/2):($2-$5/2):4:5 with vectors nohead lw 2 title 'tangent d(psi)/dp'\n"
-       << "set ylabel 'd(psi)/d(" << P << ")'\n"
+       << "set ylabel 'd(" << r.objectives[o] << ")/d(" << P << ")"
+       << (engine::unit_per(r.objective_units[o], r.unit).empty() ? "" : " [" + engine::unit_per(r.objective_units[o], r.unit) + "]") << "'\n"
        << "plot '" << dir << "/plots/sweep_" << name << ".dat' using 1:3 with linespoints pt 7 title 'exact d(psi)/dp'\n"
        << "unset multiplot\n";
     md << "![" << r.objectives[o] << "](plots/sweep_" << name << ".png)\n\n";

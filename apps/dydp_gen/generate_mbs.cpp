@@ -25,6 +25,31 @@ std::string string_array(const std::string& name, const std::vector<std::string>
   return s + "};\n";
 }
 
+/// The SI unit of a sensor port; components of different units are listed, comma-separated.
+std::string sensor_unit(const mbs::Model& model, const mbs::Sensor& sensor) {
+  using Type = mbs::Sensor::Type;
+  std::vector<std::string> units;
+  for (int c : sensor.components) {
+    std::string u;
+    switch (sensor.type) {
+      case Type::Position: u = "m"; break;
+      case Type::Velocity: u = "m/s"; break;
+      case Type::Acceleration: u = "m/s^2"; break;
+      case Type::AngularVelocity: u = "rad/s"; break;
+      case Type::Length: u = c == 0 ? "m" : "m/s"; break;
+      case Type::Joint: {
+        const bool rotation = mbs::is_revolute(model.joints[sensor.joint].type);
+        u = std::string(rotation ? "rad" : "m") + (c == 0 ? "" : c == 1 ? "/s" : "/s^2");
+        break;
+      }
+    }
+    if (std::find(units.begin(), units.end(), u) == units.end()) units.push_back(u);
+  }
+  std::string out;
+  for (const auto& u : units) out += (out.empty() ? "" : ", ") + u;
+  return out;
+}
+
 template <class T>
 std::string number_array(const std::string& type, const std::string& name, const std::vector<T>& items) {
   std::ostringstream s;
@@ -163,8 +188,10 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += string_array("sensor_names", model.sensor_output_names());
   std::vector<std::string> sensor_ports;
   std::vector<int> sensor_widths, sensor_acc;
+  std::vector<std::string> sensor_units;
   for (const auto& sensor : model.sensors) {
     sensor_ports.push_back(sensor.name);
+    sensor_units.push_back(sensor_unit(model, sensor));
     sensor_widths.push_back(sensor.width());
     const bool reads_qdd = std::find(sensor.components.begin(), sensor.components.end(), 2) != sensor.components.end();
     sensor_acc.push_back(sensor.type == mbs::Sensor::Type::Acceleration ||
@@ -181,6 +208,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += string_array("sensor_ports", sensor_ports);
   d += number_array("int", "sensor_widths", sensor_widths);
   d += number_array("int", "sensor_reads_acceleration", sensor_acc);
+  d += string_array("sensor_units", sensor_units);
   d += number_array("double", "initial_q", q0);
   d += number_array("int", "driven", driven);
   d += number_array("int", "independent", independent);
@@ -196,7 +224,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += "    " + std::to_string(driven.size()) + ", driven, " + std::to_string(independent.size()) + ", independent,\n";
   d += "    " + name + "_mass, " + name + "_residual, " + name + "_residual_tangent, " + name + "_constraints,\n";
   d += "    " + name + "_velocity_constraints_tangent, " + name + "_sensors, " + name + "_sensors_tangent,\n";
-  d += "    " + std::to_string(model.load_input_count()) + ", load_names, load_widths};\n\n";
+  d += "    " + std::to_string(model.load_input_count()) + ", load_names, load_widths, sensor_units};\n\n";
   d += "}  // namespace dydp::generated\n";
   write_atomically(options.out_dir / (name + "_model.cpp"), d);
   return result;

@@ -54,6 +54,7 @@ struct GeneratedModel {
   int load_inputs;
   const char* const* load_names;
   const int* load_widths;
+  const char* const* sensor_units;  // SI unit of each sensor port ("m", "m/s", "rad", ...)
 };
 
 }  // namespace dydp::mbs

@@ -118,5 +118,26 @@ TEST(ReferenceStudies, StifferFrontAntiRollBarGivesMoreUndersteer) {
   EXPECT_LT(runs.front().at("beta"), 0.0);
 }
 
+TEST(ReferenceStudies, ObjectivesCarryTheirUnits) {
+  // Units come from the generated model's sensors, through pass-through blocks (demux, the
+  // ISO filter's declared unit), and from the objective's kind (slip angle: rad).
+  const auto run = run_scene(write_scene("cornering_units.yaml", read_scenario("cornering_arb.yaml")), {}, false);
+  EXPECT_EQ(objective(run, "beta").unit, "rad");
+  EXPECT_EQ(objective(run, "yaw_rate").unit, "rad/s");
+  EXPECT_EQ(objective(run, "lateral_acc").unit, "m/s^2");
+  EXPECT_EQ(objective(run, "roll").unit, "rad");
+  const engine::Diagram qc = engine::load_scene(std::string(DYDP_SOURCE_DIR) + "/scenarios/quarter_car_cdc.yaml");
+  std::map<std::string, std::string> units;
+  for (int o : qc.objectives) {
+    const engine::Node& n = qc.nodes[o];
+    units[n.name] = n.objective->unit(qc.signal_unit(n.input_source[0]));
+  }
+  EXPECT_EQ(units.at("comfort_rms"), "m/s^2");  // car.body acceleration sensor -> demux -> rms
+  EXPECT_EQ(units.at("comfort_wk"), "m/s^2");
+  EXPECT_EQ(units.at("damper_power"), "W");
+  EXPECT_EQ(engine::unit_per("m/s^2", "A"), "m/s^2 / A");
+  EXPECT_EQ(engine::unit_per("rad", "N m/rad"), "rad / (N m/rad)");
+}
+
 }  // namespace
 }  // namespace dydp::test
