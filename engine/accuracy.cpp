@@ -2,13 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "engine/errors.hpp"
 
 namespace dydp::engine {
 namespace {
 
-double rel(double a, double b, double scale) { return std::fabs(a - b) / std::max(scale, 1e-300); }
+/// |a - b| / scale; infinite when a is not finite (so that a NaN never reads as "no error").
+double rel(double a, double b, double scale) {
+  const double e = std::fabs(a - b) / std::max(scale, 1e-300);
+  return std::isfinite(e) ? e : std::numeric_limits<double>::infinity();
+}
 
 /// Fills the error fields of row from run r against the reference.
 void measure(const RunResult& r, const RunResult& ref, AccuracyRow& row) {

@@ -27,6 +27,13 @@ void Recorder::record(double t, const double* x, Evaluator& ev) {
   const auto& sig = ev.signals();
   const auto& dsig = ev.signal_tangents();
   const int nsig = d_.num_signals;
+  // Sensitivities that overflowed (an unstable explicit step on a stiff scene) stop the run too.
+  for (const LoggedSignal& s : d_.logged)
+    for (int dir = 0; dir < ns_; ++dir)
+      if (!std::isfinite(dsig[dir * nsig + s.offset]))
+        throw SolverError(t, s.name.substr(0, s.name.find('.')),
+                          "sensitivity of " + s.name + " is not finite: the sensitivities diverged (step too large for "
+                          "a stiff scene?)");
   result_.t.push_back(t);
   for (const LoggedSignal& s : d_.logged) result_.values.push_back(sig[s.offset]);
   for (int dir = 0; dir < ns_; ++dir)
@@ -66,6 +73,10 @@ void Recorder::finish(const double* q, ConstDirView dq) {
     r.value = n.objective->objective(n.p.data(), q + n.quad_offset, dq_node, s, r.sensitivity.data());
     if (!std::isfinite(r.value))
       throw SolverError(d_.time.stop, n.name, "objective value is not finite");
+    for (size_t k = 0; k < r.sensitivity.size(); ++k)
+      if (!std::isfinite(r.sensitivity[k]))
+        throw SolverError(d_.time.stop, n.name, "objective sensitivity is not finite (direction " + std::to_string(k) +
+                                                    "): the sensitivities diverged; a smaller step or an implicit method?");
     result_.objectives.push_back(std::move(r));
   }
 }

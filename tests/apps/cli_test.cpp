@@ -594,6 +594,21 @@ TEST_F(Cli, StiffHydraulicsFailuresAreReportedNotWritten) {
   EXPECT_FALSE(fs::exists(dir_ / "rk4" / "signals.csv"));
 }
 
+// RK4 at 0.1 ms on the quarter car keeps its states bounded but its sensitivities grow without
+// bound (the hydraulic modes are unstable in the step's tangent map): the run stops naming them.
+TEST_F(Cli, DivergingSensitivitiesStopTheRun) {
+  std::string text = scene_text(fs::path(DYDP_SOURCE_DIR) / "scenarios" / "quarter_car_cdc.yaml");
+  const std::string solver = "solver: {method: bdf, rtol: 1.0e-6, atol: 1.0e-8}";
+  ASSERT_NE(text.find(solver), std::string::npos);
+  text.replace(text.find(solver), solver.size(), "solver: {method: rk4, step: 0.0001}");
+  const Result r = dydp("run " + quote(write("qc_rk4.yaml", text)) + " --out " + quote((dir_ / "qc_rk4").string()));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("t = "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("sensitivit"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("not finite"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "qc_rk4" / "signals.csv"));
+}
+
 // Across the pothole's edges (breakpoints, wheel lift-off) the exact sensitivity of the comfort
 // figure to the valve current agrees with central differences of whole runs.
 TEST_F(Cli, PotholeSensitivityAgreesWithCentralDifferences) {
