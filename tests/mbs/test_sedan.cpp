@@ -274,7 +274,7 @@ TEST(Sedan, RideFrequencies) {
 
 // The multibody.sedan block in a scene: linear springs preloaded for the design position,
 // linear dampers (math.gain on the stroke rate, tension positive), tyre.vertical on a flat road
-// at z = 0, rack held by its servo at 0. Dropped from 1 cm above the design position, the car
+// at z = 0, rack held at 0 by its inputs. Dropped from 1 cm above the design position, the car
 // settles back into it (its static equilibrium); every feedback path (springs, dampers, tyres)
 // runs through states, so the scene has no algebraic loop.
 TEST(SedanScene, RestsInItsDesignPosition) {
