@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "engine/registry.hpp"
+#include "tests/temp_folder_test.hpp"
 
 namespace {
 
@@ -49,16 +50,9 @@ std::vector<std::string> split(const std::string& text, char sep) {
   return out;
 }
 
-class Cli : public ::testing::Test {
+class Cli : public dydp::test::TempFolderTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("dydp_cli_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  Cli() : TempFolderTest("dydp_cli_") {}
 
   /// Runs `dydp ARGS` (ARGS already quoted), capturing stdout, stderr and the exit status.
   Result dydp(const std::string& args) const {
@@ -73,12 +67,6 @@ class Cli : public ::testing::Test {
     return r;
   }
 
-  std::string write(const std::string& name, const std::string& text) const {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
-
   static std::string msd_scene() {
     return (fs::path(DYDP_SOURCE_DIR) / "scenarios" / "msd_sensitivity.yaml").string();
   }
@@ -90,8 +78,6 @@ class Cli : public ::testing::Test {
     for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
     return names;
   }
-
-  fs::path dir_;
 };
 
 std::string join(const std::vector<std::string>& v) {

@@ -3,10 +3,8 @@
 // only another output reads is no algebraic loop; values and tangents follow the chain.
 // Wiring an output back into an input it reads is a loop, reported at the file's line.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -15,6 +13,7 @@
 #include "engine/errors.hpp"
 #include "engine/evaluator.hpp"
 #include "engine/registry.hpp"
+#include "tests/temp_folder_test.hpp"
 
 namespace dydp::engine {
 namespace {
@@ -60,29 +59,16 @@ const BlockRegistration registration({"test.split_feedthrough", "test",
                                         return std::make_unique<SplitFeedthrough>();
                                       }});
 
-class Feedthrough : public ::testing::Test {
+class Feedthrough : public test::TempFolderTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("dydp_feedthrough_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  Feedthrough() : TempFolderTest("dydp_feedthrough_") {}
 
-  std::string write(const std::string& text) const {
-    const fs::path p = dir_ / "s.yaml";
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
+  std::string write(const std::string& text) const { return TempFolderTest::write("s.yaml", text); }
   static int index_of(const Diagram& d, const std::string& name) {
     for (size_t i = 0; i < d.nodes.size(); ++i)
       if (d.nodes[i].name == name) return static_cast<int>(i);
     return -1;
   }
-
-  fs::path dir_;
 };
 
 // src.y = a -> b.u1; b.y1 -> gain (k) -> b.u2. With x the state of b:

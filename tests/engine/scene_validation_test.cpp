@@ -5,17 +5,16 @@
 // Each scene is a raw string literal whose first line is line 1 of the file, so the expected
 // line numbers can be counted in the literal.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "engine/diagram.hpp"
 #include "engine/errors.hpp"
+#include "tests/temp_folder_test.hpp"
 
 namespace dydp::engine {
 namespace {
@@ -23,23 +22,9 @@ namespace {
 namespace fs = std::filesystem;
 using Overrides = std::vector<std::pair<std::string, std::string>>;
 
-class SceneValidation : public ::testing::Test {
+class SceneValidation : public test::TempFolderTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("dydp_scene_validation_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  /// Writes `text` to dir/name and returns its path.
-  std::string write(const std::string& name, const std::string& text) const {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
+  SceneValidation() : TempFolderTest("dydp_scene_validation_") {}
 
   /// Loads the scene and returns the InputError it must raise (a failure when none is raised).
   static InputError load_error(const std::string& path, const Overrides& overrides = {}) {
@@ -81,8 +66,6 @@ class SceneValidation : public ::testing::Test {
         return static_cast<int>(k);
     return -1;
   }
-
-  fs::path dir_;
 };
 
 // ---------------------------------------------------------------- errors of the graph
