@@ -95,6 +95,8 @@ class Diagram {
   /// Unit of the signal at `offset` (an output's element), following outputs that carry their
   /// first input's unit upstream; "" when unknown.
   std::string signal_unit(int offset) const;
+  /// Unit of an objective node's psi: its kind applied to the unit of its first input.
+  std::string objective_unit(const Node& n) const;
   /// Sets a scene parameter and every block parameter it drives; checks the bounds of both
   /// (the scene parameter's range only with check_range: finite differences step past it).
   void set_parameter(int index, double value, bool check_range = true);

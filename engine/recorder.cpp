@@ -67,7 +67,7 @@ void Recorder::finish(const double* q, ConstDirView dq) {
     s.du = &samples_[o].du;
     ObjectiveResult r;
     r.name = n.name;
-    r.unit = n.objective->unit(n.input_source.empty() ? std::string() : d_.signal_unit(n.input_source[0]));
+    r.unit = d_.objective_unit(n);
     r.sensitivity.assign(ns_, 0.0);
     const ConstDirView dq_node = dq.zero() ? ConstDirView{} : ConstDirView{dq.data + n.quad_offset, dq.ld};
     r.value = n.objective->objective(n.p.data(), q + n.quad_offset, dq_node, s, r.sensitivity.data());

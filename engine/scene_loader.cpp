@@ -306,6 +306,10 @@ std::string Diagram::signal_unit(int offset) const {
   return "";
 }
 
+std::string Diagram::objective_unit(const Node& n) const {
+  return n.objective->unit(n.input_source.empty() ? std::string() : signal_unit(n.input_source[0]));
+}
+
 int Diagram::find_parameter(const std::string& name) const {
   for (size_t i = 0; i < parameters.size(); ++i)
     if (parameters[i].name == name) return static_cast<int>(i);

@@ -42,10 +42,8 @@ SweepResult sweep(const SweepSpec& spec) {
   result.unit = sp.unit;
   result.fd_steps = spec.fd_steps;
   for (int o : probe.objectives) {
-    const Node& n = probe.nodes[o];
-    result.objectives.push_back(n.name);
-    result.objective_units.push_back(
-        n.objective->unit(n.input_source.empty() ? std::string() : probe.signal_unit(n.input_source[0])));
+    result.objectives.push_back(probe.nodes[o].name);
+    result.objective_units.push_back(probe.objective_unit(probe.nodes[o]));
   }
   result.points.resize(spec.points);
   for (int k = 0; k < spec.points; ++k)

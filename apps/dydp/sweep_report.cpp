@@ -60,14 +60,16 @@ void write_sweep_report(const std::string& dir, const std::string& scene, const 
     for (const auto& pt : r.points)
       data << pt.p << ' ' << pt.psi[o] << ' ' << pt.dpsi[o] << ' ' << 0.3 * span << ' ' << 0.3 * span * pt.dpsi[o] << '\n';
     write_data(dir + "/plots/sweep_" + name + ".dat", data.str());
+    const std::string& ou = r.objective_units[o];
+    const std::string du = engine::unit_per(ou, r.unit);
     gp << "set output '" << dir << "/plots/sweep_" << name << ".png'\n"
        << "set multiplot layout 2,1 title '" << r.objectives[o] << " against " << P << "'\n"
        << "set xlabel '" << P << unit << "'\nset ylabel '" << r.objectives[o]
-       << (r.objective_units[o].empty() ? "" : " [" + r.objective_units[o] + "]") << "'\n"
+       << (ou.empty() ? "" : " [" + ou + "]") << "'\n"
        << "plot '" << dir << "/plots/sweep_" << name << ".dat' using 1:2 with linespoints pt 7 title 'psi', "
        << "'' using ($1-$4/2):($2-$5/2):4:5 with vectors nohead lw 2 title 'tangent d(psi)/dp'\n"
        << "set ylabel 'd(" << r.objectives[o] << ")/d(" << P << ")"
-       << (engine::unit_per(r.objective_units[o], r.unit).empty() ? "" : " [" + engine::unit_per(r.objective_units[o], r.unit) + "]") << "'\n"
+       << (du.empty() ? "" : " [" + du + "]") << "'\n"
        << "plot '" << dir << "/plots/sweep_" << name << ".dat' using 1:3 with linespoints pt 7 title 'exact d(psi)/dp'\n"
        << "unset multiplot\n";
     md << "![" << r.objectives[o] << "](plots/sweep_" << name << ".png)\n\n";

@@ -128,10 +128,7 @@ TEST(ReferenceStudies, ObjectivesCarryTheirUnits) {
   EXPECT_EQ(objective(run, "roll").unit, "rad");
   const engine::Diagram qc = engine::load_scene(std::string(DYDP_SOURCE_DIR) + "/scenarios/quarter_car_cdc.yaml");
   std::map<std::string, std::string> units;
-  for (int o : qc.objectives) {
-    const engine::Node& n = qc.nodes[o];
-    units[n.name] = n.objective->unit(qc.signal_unit(n.input_source[0]));
-  }
+  for (int o : qc.objectives) units[qc.nodes[o].name] = qc.objective_unit(qc.nodes[o]);
   EXPECT_EQ(units.at("comfort_rms"), "m/s^2");  // car.body acceleration sensor -> demux -> rms
   EXPECT_EQ(units.at("comfort_wk"), "m/s^2");
   EXPECT_EQ(units.at("damper_power"), "W");
