@@ -240,6 +240,16 @@ class DamperCdc : public Block {
       dxdot(kQValve, d) = t.qdot;
     }
   }
+  // The pressures' derivatives are what makes the damper stiff and nonlinear (orifice laws over
+  // small chamber volumes); this 4 x 4 block costs one tangent of this block alone.
+  bool local_jacobian(const Eval& e, DirView jac) const override {
+    double identity[16] = {};
+    for (int i = 0; i < 4; ++i) identity[i * 4 + i] = 1.0;
+    const engine::ConstDirView held[2] = {};  // stroke and stroke rate held
+    const Seeds s{4, {identity, 4}, held, {}};
+    derivatives_tangent(e, s, jac);
+    return true;
+  }
 };
 
 const engine::BlockRegistration damper_cdc({

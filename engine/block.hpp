@@ -140,6 +140,11 @@ class Block {
   virtual void derivatives(const Eval& e, double* xdot) const {}
   /// dxdot = f_x dx + f_u du + f_p dp.
   virtual void derivatives_tangent(const Eval& e, const Seeds& s, DirView dxdot) const {}
+  /// Optional: d(xdot)/dx over the block's own states with its inputs held, column j at
+  /// jac.data + j * jac.ld. Blocks whose derivatives are cheap but strongly nonlinear in their
+  /// own states (hydraulic chambers) provide it, so that an implicit solver can refresh this
+  /// diagonal block of its iteration matrix without a whole Jacobian. False: not provided.
+  virtual bool local_jacobian(const Eval& e, DirView jac) const { return false; }
 
   /// Integrands of the block's quadratures (objective integrals), and their tangents.
   virtual void quadratures(const Eval& e, double* qdot) const {}

@@ -200,6 +200,19 @@ void Evaluator::tangents(double t, const double* x, int nd, ConstDirView dx, boo
   }
 }
 
+bool Evaluator::local_jacobians(double t, const double* x, double* jac, int ld) {
+  outputs(t, x);
+  bool any = false;
+  for (size_t i = 0; i < d_.nodes.size(); ++i) {
+    const Node& n = d_.nodes[i];
+    if (n.block->num_states() == 0) continue;
+    const Eval e = eval_for(n, static_cast<int>(i), t, x);
+    double* block = jac + static_cast<size_t>(n.state_offset) * ld + n.state_offset;
+    call_block(n, [&] { any = n.block->local_jacobian(e, {block, ld}) || any; });
+  }
+  return any;
+}
+
 bool Evaluator::all_finite(const double* xdot) const {
   // One sum decides the common case; an overflow to inf merely sends us to the full scan.
   double sum = 0.0;

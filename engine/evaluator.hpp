@@ -40,6 +40,10 @@ class Evaluator {
   void tangents(double t, const double* x, int nd, ConstDirView dx, bool with_params,
                 DirView dxdot, DirView dqdot);
 
+  /// Overwrites the diagonal block d(xdot_b)/dx_b of jac (column-major, leading dimension ld)
+  /// for every block that provides Block::local_jacobian, at (t, x). False when none does.
+  bool local_jacobians(double t, const double* x, double* jac, int ld);
+
   const std::vector<double>& signals() const { return sig_; }
   /// Signal tangents of the last tangent pass: element (i, d) at [d * num_signals + i].
   const std::vector<double>& signal_tangents() const { return dsig_; }

@@ -30,6 +30,7 @@ struct RunStats {
   long rhs_evals = 0;             ///< value passes for state derivatives
   long sens_rhs_evals = 0;        ///< tangent passes for the sensitivity equations
   long jac_evals = 0;             ///< Jacobians (each one tangent pass over all states)
+  long local_jac_evals = 0;       ///< refreshes of the blocks' own diagonal Jacobian blocks only
   long error_test_failures = 0;
   long nonlinear_iterations = 0;
   long nonlinear_failures = 0;    ///< corrector convergence failures (step retried smaller)

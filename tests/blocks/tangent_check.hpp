@@ -229,6 +229,22 @@ inline Values tangents(const engine::Block& b, const Point& pt, int nd) {
   return out;
 }
 
+/// Block::local_jacobian at the point (nx x nx, column-major), or empty when not provided.
+inline std::vector<double> local_jacobian(const engine::Block& b, const Point& pt) {
+  const int nx = b.num_states();
+  std::vector<const double*> u;
+  for (const auto& v : pt.u) u.push_back(v.data());
+  engine::Eval e;
+  e.t = pt.t;
+  e.segment_start = pt.t;
+  e.x = pt.x.data();
+  e.u = u.data();
+  e.p = pt.p.data();
+  std::vector<double> jac(static_cast<size_t>(nx) * nx, std::numeric_limits<double>::quiet_NaN());
+  if (nx == 0 || !b.local_jacobian(e, {jac.data(), nx})) return {};
+  return jac;
+}
+
 }  // namespace detail
 
 /// Runs the check for every sample and time; failures name the function, row and variable.
@@ -272,6 +288,14 @@ inline void check_tangents(const BlockCase& c) {
 
       const detail::Values base = detail::evaluate(b, pt);
       const detail::Values an = detail::tangents(b, pt, nd);
+      // A local Jacobian, where the block provides one, is the state columns of the derivative
+      // tangents (checked against finite differences below).
+      const std::vector<double> local = detail::local_jacobian(b, pt);
+      for (size_t k = 0; k < local.size(); ++k) {
+        const double expected = an.xdot[k];  // column k / nx is state direction k / nx
+        EXPECT_NEAR(local[k], expected, 1e-12 * (std::fabs(expected) + 1e-300))
+            << c.type << ": local_jacobian row " << k % nx << " by " << names[k / nx];
+      }
       // Perturbs variable v of a copy of the point by h.
       const auto perturbed = [&](int v, double h) {
         detail::Point q = pt;
