@@ -74,12 +74,6 @@ void ReducedDynamics::solve(const double* u, const double* ud, const double* inp
     evaluate_constraints();  // Jdot qd with the completed velocities
   }
 
-  // M from the inertial pass seeded on unit accelerations.
-  std::vector<double> out(n), dout(static_cast<std::size_t>(n) * n);
-  const Matrix eye = Matrix::Identity(n, n);
-  model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, n, eye.data(), out.data(), dout.data());
-  r.M = Eigen::Map<const Matrix>(dout.data(), n, n);
-
   // c (with the driven accelerations) and the constraint bias.
   std::vector<double> res(n + m);
   model_.residual(r.q.data(), r.qd.data(), r.qdd.data(), lam_zero.data(), in, p, res.data());
@@ -87,9 +81,6 @@ void ReducedDynamics::solve(const double* u, const double* ud, const double* inp
   const Vector a0 = Eigen::Map<const Vector>(res.data() + n, m);
 
   const int nf = static_cast<int>(f_.size());
-  Matrix Mff(nf, nf);
-  for (int a = 0; a < nf; ++a)
-    for (int b = 0; b < nf; ++b) Mff(a, b) = r.M(f_[a], f_[b]);
   // B over the free coordinates: rows u (identity) and v (-Jv^-1 Ju).
   r.B = Matrix::Zero(nf, nu);
   Vector beta = Vector::Zero(nf);
@@ -109,24 +100,42 @@ void ReducedDynamics::solve(const double* u, const double* ud, const double* inp
       beta[a] = beta_v(iv, 0);
     }
   }
+
+  // M [B beta] from the inertial pass seeded on those accelerations (nu + 1 directions; M
+  // itself, n directions, is never formed): M qdd for qdd = B udd + beta is all we need.
+  const int k = nu + (m > 0 ? 1 : 0);
+  Matrix seeds = Matrix::Zero(n, k);
+  for (int a = 0; a < nf; ++a) {
+    seeds.row(f_[a]).head(nu) = r.B.row(a);
+    if (m > 0) seeds(f_[a], nu) = beta[a];
+  }
+  std::vector<double> out(n);
+  r.MB.resize(n, k);
+  model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, k, seeds.data(), out.data(), r.MB.data());
+
+  Matrix MBf(nf, nu);  // M_ff B
+  Vector Mbeta = Vector::Zero(nf);
   Vector cf(nf);
-  for (int a = 0; a < nf; ++a) cf[a] = c[f_[a]];
+  for (int a = 0; a < nf; ++a) {
+    MBf.row(a) = r.MB.row(f_[a]).head(nu);
+    if (m > 0) Mbeta[a] = r.MB(f_[a], nu);
+    cf[a] = c[f_[a]];
+  }
   // a tree (no constraints, u in coordinate order): B = I, and the products would cost two
   // dense n^3 products
   const bool identity = m == 0 && u_ == f_;
-  if (identity) r.reduced.compute(Mff);
-  else r.reduced.compute(r.B.transpose() * Mff * r.B);
+  if (identity) r.reduced.compute(MBf);
+  else r.reduced.compute(r.B.transpose() * MBf);
   if (r.reduced.info() != Eigen::Success)
     throw std::runtime_error(std::string(model_.name) + ": reduced mass matrix is not positive definite");
-  r.udd = identity ? Vector(r.reduced.solve(-cf)) : Vector(r.reduced.solve(-(r.B.transpose() * (cf + Mff * beta))));
+  r.udd = identity ? Vector(r.reduced.solve(-cf)) : Vector(r.reduced.solve(-(r.B.transpose() * (cf + Mbeta))));
   const Vector qddf = r.B * r.udd + beta;
   for (int a = 0; a < nf; ++a) r.qdd[f_[a]] = qddf[a];
 
-  // Multipliers: J^T lam = M qdd + c on the dependent rows.
+  // Multipliers: J^T lam = M qdd + c on the dependent rows, M qdd = M B udd + M beta.
   r.lam = Vector::Zero(m);
   if (m > 0) {
-    Vector full = c;
-    for (int a = 0; a < nf; ++a) full += r.M.col(f_[a]) * qddf[a];
+    const Vector full = c + r.MB.leftCols(nu) * r.udd + r.MB.col(nu);
     Vector fv(m);
     for (int i = 0; i < m; ++i) fv[i] = full[v_[i]];
     r.lam = r.Jv.transpose().solve(fv);
@@ -178,7 +187,7 @@ void ReducedDynamics::tangent(const Result& r, const double* inputs, const doubl
   model_.residual_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), in, p, nd, dq.data(), dqd.data(),
                           dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
   const int nf = static_cast<int>(f_.size());
-  Matrix dbeta = Matrix::Zero(nf, nd), drf(nf, nd), Mff(nf, nf);
+  Matrix dbeta = Matrix::Zero(nf, nd), drf(nf, nd);
   if (m > 0) {
     const Matrix dbeta_v = -r.Jv.solve(Matrix(dout.bottomRows(m)));
     for (int a = 0; a < nf; ++a) {
@@ -186,11 +195,13 @@ void ReducedDynamics::tangent(const Result& r, const double* inputs, const doubl
       if (iv != v_.end()) dbeta.row(a) = dbeta_v.row(iv - v_.begin());
     }
   }
+  Matrix MBf(nf, nu);  // M_ff B; B^T M_ff dbeta = (M_ff B)^T dbeta, M being symmetric
   for (int a = 0; a < nf; ++a) {
     drf.row(a) = dout.row(f_[a]);
-    for (int b = 0; b < nf; ++b) Mff(a, b) = r.M(f_[a], f_[b]);
+    MBf.row(a) = r.MB.row(f_[a]).head(nu);
   }
-  const Matrix dudd = m == 0 && u_ == f_ ? Matrix(r.reduced.solve(-drf)) : Matrix(r.reduced.solve(-(r.B.transpose() * (drf + Mff * dbeta))));
+  const Matrix dudd = m == 0 && u_ == f_ ? Matrix(r.reduced.solve(-drf))
+                                          : Matrix(r.reduced.solve(-(r.B.transpose() * drf + MBf.transpose() * dbeta)));
   const Matrix dqddf = r.B * dudd + dbeta;
   for (int a = 0; a < nf; ++a) dqdd.row(f_[a]) = dqddf.row(a);
 }

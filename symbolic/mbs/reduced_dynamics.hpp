@@ -25,7 +25,7 @@ class ReducedDynamics {
   struct Result {
     Vector q, qd, qdd, lam;
     Vector udd;
-    Matrix M;                                     // n x n
+    Matrix MB;                                    // M [B beta]: n x (nu + 1 if m > 0)
     Matrix J;                                     // m x n
     Eigen::PartialPivLU<Matrix> Jv;               // dependent columns of J
     Matrix B;                                     // free coordinates x nu
