@@ -203,6 +203,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   check(CVodeSetUserData(S.mem, &P), "CVodeSetUserData");
   check(CVodeSStolerances(S.mem, d.solver.rtol, d.solver.atol), "CVodeSStolerances");
   check(CVodeSetMaxNumSteps(S.mem, d.solver.max_steps), "CVodeSetMaxNumSteps");
+  check(CVodeSetMinStep(S.mem, d.solver.min_step), "CVodeSetMinStep");
   if (bdf) {
     S.A = SUNDenseMatrix(n_cv, n_cv, S.ctx);
     S.LS = SUNLinSol_Dense(S.y, S.A, S.ctx);

@@ -27,6 +27,9 @@ struct SolverSpec {
   double atol = 1e-8;
   double step = 0.0;           ///< fixed-step methods; 0: output_step / 10
   long max_steps = 500000;     ///< per output interval (CVODES mxstep)
+  /// CVODES: smallest step [s]. A run that needs a smaller one (a block refusing every point
+  /// ahead, a solution gone singular) stops naming time and block instead of crawling.
+  double min_step = 1e-12;
   /// CVODES: include the sensitivities (and quadrature sensitivities) in the error test.
   /// Off, the steps are chosen for the states alone: cheaper, sensitivities less controlled.
   bool sens_error_test = true;

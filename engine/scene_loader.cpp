@@ -70,7 +70,7 @@ void read_time(const SceneReader& r, const YAML::Node& n, TimeSpec& time) {
 
 void read_solver(const SceneReader& r, const YAML::Node& n, SolverSpec& s) {
   if (!n) return;
-  r.allow_keys(n, "solver", {"method", "rtol", "atol", "step", "max_steps", "sens_error_test"});
+  r.allow_keys(n, "solver", {"method", "rtol", "atol", "step", "max_steps", "min_step", "sens_error_test"});
   if (n["method"]) {
     s.method = r.text(n["method"], "solver.method");
     if (s.method != "bdf" && s.method != "adams" && s.method != "rk4" && s.method != "sdirk2")
@@ -85,6 +85,8 @@ void read_solver(const SceneReader& r, const YAML::Node& n, SolverSpec& s) {
     s.sens_error_test = v == "true";
   }
   if (n["max_steps"]) s.max_steps = static_cast<long>(r.number(n["max_steps"], "solver.max_steps"));
+  if (n["min_step"]) s.min_step = r.number(n["min_step"], "solver.min_step");
+  if (!(s.min_step >= 0)) r.fail(n["min_step"], "solver.min_step", "must not be negative");
   if (!(s.rtol > 0)) r.fail(n["rtol"], "solver.rtol", "must be positive");
   if (!(s.atol > 0)) r.fail(n["atol"], "solver.atol", "must be positive");
   if (s.step < 0) r.fail(n["step"], "solver.step", "must be positive");

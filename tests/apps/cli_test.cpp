@@ -561,7 +561,20 @@ TEST_F(Cli, StressScenesCompleteOrStopNamingTimeAndBlock) {
     EXPECT_NE(r.err.find("block "), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out / "signals.csv")) << "nothing half written";
   }
-  EXPECT_GE(count, 7);
+  EXPECT_GE(count, 8);
+}
+
+// A run whose block refuses every point ahead stops at the smallest step (solver.min_step)
+// naming time, block and reason, instead of crawling on at ever smaller steps; with the guard
+// off (min_step: 0) the same run was still at t = 2.2673 s after five minutes.
+TEST_F(Cli, RefusedPointsAheadStopTheRunAtTheSmallestStep) {
+  const fs::path src = fs::path(DYDP_SOURCE_DIR) / "scenarios" / "stress" / "cornering_wheelspin.yaml";
+  const Result r = dydp("run " + quote(src.string()) + " --no-sens --out " + quote((dir_ / "spin").string()));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("t = 2.2"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("block damper_fr"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("stroke beyond the chambers' length"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "spin" / "signals.csv"));
 }
 
 // RK4 at a millisecond step on the stiffest scene reports the instability instead of writing non-finite numbers.

@@ -607,6 +607,19 @@ outputs: [src.y]
   expect_error(load_error(path), path, 5, "solver.atol", "must be positive");
 }
 
+TEST_F(SceneValidation, NegativeMinStep) {
+  const std::string path = write("s.yaml", R"(scene: t
+time: {stop: 1.0, output_step: 0.1}
+solver:
+  method: bdf
+  min_step: -1.0e-12
+blocks:
+  src: {type: source.sine}
+outputs: [src.y]
+)");
+  expect_error(load_error(path), path, 5, "solver.min_step", "must not be negative");
+}
+
 TEST_F(SceneValidation, MalformedCsvTableNamesTheCsvFileAndRow) {
   const std::string csv = write("road.csv", "t,z\n0.0,0.0\n0.5,0.01\n1.0,abc\n");
   const std::string path = write("s.yaml", R"(scene: t
