@@ -75,7 +75,7 @@ class Multibody : public Block {
       // mechanism is assembled in the same branch every run
       std::lock_guard<std::mutex> lock(mutex_);
       last_q_ = Eigen::Map<const Vector>(g_.initial_q, g_.n);
-      have_ = false;
+      have_kinematics_ = have_dynamics_ = false;
     }
     const int nu = reduced_.nu();
     for (int i = 0; i < nu; ++i) {
@@ -90,7 +90,7 @@ class Multibody : public Block {
   }
 
   void outputs(const Eval& e, double* const* y) const override {
-    const ReducedDynamics::Result& r = solve(e);
+    const ReducedDynamics::Result& r = solve(e, needs_dynamics(e));
     const int n = g_.n;
     if (output_ready(e, 0)) std::copy_n(r.q.data(), n, y[0]);
     if (output_ready(e, 1)) std::copy_n(r.qd.data(), n, y[1]);
@@ -108,9 +108,10 @@ class Multibody : public Block {
   }
 
   void outputs_tangent(const Eval& e, const Seeds& s, const DirView* dy) const override {
-    const ReducedDynamics::Result& r = solve(e);
+    const bool dynamics = needs_dynamics(e);
+    const ReducedDynamics::Result& r = solve(e, dynamics);
     Matrix dq, dqd, dqdd, dinp, dp;
-    tangent(e, s, r, dq, dqd, dqdd, dinp, dp);
+    tangent(e, s, r, dynamics, dq, dqd, dqdd, dinp, dp);
     const int n = g_.n, nd = s.directions;
     const bool motion = output_ready(e, 0), acceleration = output_ready(e, 2);
     for (int d = 0; d < nd; ++d)
@@ -136,7 +137,7 @@ class Multibody : public Block {
   }
 
   void derivatives(const Eval& e, double* xdot) const override {
-    const ReducedDynamics::Result& r = solve(e);
+    const ReducedDynamics::Result& r = solve(e, true);
     const int nu = reduced_.nu();
     for (int i = 0; i < nu; ++i) {
       xdot[i] = e.x[nu + i];
@@ -145,9 +146,9 @@ class Multibody : public Block {
   }
 
   void derivatives_tangent(const Eval& e, const Seeds& s, DirView dxdot) const override {
-    const ReducedDynamics::Result& r = solve(e);
+    const ReducedDynamics::Result& r = solve(e, true);
     Matrix dq, dqd, dqdd, dinp, dp;
-    tangent(e, s, r, dq, dqd, dqdd, dinp, dp);
+    tangent(e, s, r, true, dq, dqd, dqdd, dinp, dp);
     const int nu = reduced_.nu();
     for (int d = 0; d < s.directions; ++d)
       for (int i = 0; i < nu; ++i) {
@@ -184,39 +185,70 @@ class Multibody : public Block {
     return at;
   }
 
-  // The partitioned dynamics at (x, inputs, p); the last result is reused for the same point.
-  const ReducedDynamics::Result& solve(const Eval& e) const {
+  // Whether this output call sets an output that reads accelerations (qdd, acceleration
+  // sensors); the call for positions and velocities comes first, before the loads are known.
+  bool needs_dynamics(const Eval& e) const {
+    if (output_ready(e, 2)) return true;
+    for (int k = 0; k < g_.sensor_count; ++k)
+      if (g_.sensor_reads_acceleration[k] && output_ready(e, 3 + k)) return true;
+    return false;
+  }
+
+  // The partitioned dynamics at (x, inputs, p) in two halves, each reused while its own
+  // arguments are unchanged: kinematics (x, the driven joints' q and qd, p), and with `dynamics`
+  // the accelerations and multipliers (also the loads and driven accelerations). A value pass
+  // asks for positions first and for accelerations once the loads are known: one solve each.
+  const ReducedDynamics::Result& solve(const Eval& e, bool dynamics) const {
     const int nu = reduced_.nu();
     const Vector in = inputs(e);
     const double* p = parameters(e);
     std::lock_guard<std::mutex> lock(mutex_);
-    Vector key(2 * nu + in.size() + g_.parameters);
-    for (int i = 0; i < 2 * nu; ++i) key[i] = e.x[i];
-    key.segment(2 * nu, in.size()) = in;
-    for (int i = 0; i < g_.parameters; ++i) key[2 * nu + in.size() + i] = p[i];
-    if (have_ && key.size() == key_.size() && key == key_) return result_;
-    try {
+    Vector kinematic(2 * nu + 2 * g_.driven_count + g_.parameters);
+    for (int i = 0; i < 2 * nu; ++i) kinematic[i] = e.x[i];
+    for (int i = 0; i < g_.driven_count; ++i) {
+      kinematic[2 * nu + 2 * i] = in[g_.load_inputs + 3 * i];
+      kinematic[2 * nu + 2 * i + 1] = in[g_.load_inputs + 3 * i + 1];
+    }
+    for (int i = 0; i < g_.parameters; ++i) kinematic[2 * nu + 2 * g_.driven_count + i] = p[i];
+    if (!(have_kinematics_ && kinematic == kinematic_key_)) {
+      have_kinematics_ = have_dynamics_ = false;
+      ++point_;
       try {
-        reduced_.solve(e.x, e.x + nu, in.data(), p, last_q_, result_);
-      } catch (const std::runtime_error&) {
-        // the last solution may be far away (a new run of the same diagram): from the model's
-        // initial configuration
-        reduced_.solve(e.x, e.x + nu, in.data(), p, Eigen::Map<const Vector>(g_.initial_q, g_.n), result_);
+        try {
+          reduced_.solve_kinematics(e.x, e.x + nu, in.data(), p, last_q_, result_);
+        } catch (const std::runtime_error&) {
+          // the last solution may be far away (a new run of the same diagram): from the model's
+          // initial configuration
+          reduced_.solve_kinematics(e.x, e.x + nu, in.data(), p, Eigen::Map<const Vector>(g_.initial_q, g_.n),
+                                    result_);
+        }
+      } catch (const std::runtime_error& failure) {
+        // a trial state the constraints cannot be closed at: the solver retries a smaller step
+        throw engine::OutOfDomain{failure.what()};
       }
+      last_q_ = result_.q;
+      kinematic_key_ = kinematic;
+      have_kinematics_ = true;
+    }
+    if (!dynamics || (have_dynamics_ && in == dynamic_key_)) return result_;
+    have_dynamics_ = false;
+    ++point_;
+    try {
+      reduced_.solve_dynamics(in.data(), p, result_);
     } catch (const std::runtime_error& failure) {
-      // a trial state the constraints cannot be closed at: the solver retries a smaller step
-      have_ = false;
       throw engine::OutOfDomain{failure.what()};
     }
     if (!result_.qdd.allFinite()) throw engine::OutOfDomain{"multibody: non-finite accelerations"};
-    last_q_ = result_.q;
-    key_ = key;
-    have_ = true;
+    dynamic_key_ = in;
+    have_dynamics_ = true;
     return result_;
   }
 
-  void tangent(const Eval& e, const Seeds& s, const ReducedDynamics::Result& r, Matrix& dq, Matrix& dqd,
-               Matrix& dqdd, Matrix& dinp, Matrix& dp) const {
+  // Tangents of q, qd and, with `dynamics`, qdd. A tangent pass asks twice for the same full
+  // tangent (the acceleration outputs, then the state derivatives): the last one is reused
+  // for the same point and the same seeds.
+  void tangent(const Eval& e, const Seeds& s, const ReducedDynamics::Result& r, bool dynamics, Matrix& dq,
+               Matrix& dqd, Matrix& dqdd, Matrix& dinp, Matrix& dp) const {
     const int nu = reduced_.nu(), nd = s.directions;
     Matrix du(nu, std::max(nd, 1)), dud(nu, std::max(nd, 1));
     dinp = Matrix::Zero(std::max(1, g_.inputs), std::max(nd, 1));
@@ -238,7 +270,24 @@ class Multibody : public Block {
         for (int i = 0; i < g_.parameters; ++i) dp(i, d) = s.p(i, d);
     }
     const Vector in = inputs(e);
+    if (!dynamics) {
+      reduced_.tangent_kinematics(r, in.data(), parameters(e), nd, du.data(), dud.data(), dinp.data(), dp.data(), dq,
+                                  dqd, dqdd);
+      return;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto same = [](const Matrix& a, const Matrix& b) {
+      return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
+    };
+    if (tangent_point_ == point_ && same(tangent_du_, du) && same(tangent_dud_, dud) &&
+        same(tangent_dinp_, dinp) && same(tangent_dp_, dp)) {
+      dq = tangent_dq_, dqd = tangent_dqd_, dqdd = tangent_dqdd_;
+      return;
+    }
     reduced_.tangent(r, in.data(), parameters(e), nd, du.data(), dud.data(), dinp.data(), dp.data(), dq, dqd, dqdd);
+    tangent_point_ = point_;
+    tangent_du_ = du, tangent_dud_ = dud, tangent_dinp_ = dinp, tangent_dp_ = dp;
+    tangent_dq_ = dq, tangent_dqd_ = dqd, tangent_dqdd_ = dqdd;
   }
 
   const GeneratedModel& g_;
@@ -246,9 +295,12 @@ class Multibody : public Block {
   bool exposed_;
   const double zero_[1] = {0.0};
   mutable std::mutex mutex_;
-  mutable Vector last_q_, key_;
+  mutable Vector last_q_, kinematic_key_, dynamic_key_;
   mutable ReducedDynamics::Result result_;
-  mutable bool have_ = false;
+  mutable bool have_kinematics_ = false, have_dynamics_ = false;
+  mutable long point_ = 0;  ///< changes whenever result_ does
+  mutable long tangent_point_ = -1;
+  mutable Matrix tangent_du_, tangent_dud_, tangent_dinp_, tangent_dp_, tangent_dq_, tangent_dqd_, tangent_dqdd_;
 };
 
 std::vector<engine::ParamSpec> exposed_parameters(const GeneratedModel& g) {

@@ -22,11 +22,26 @@ ReducedDynamics::ReducedDynamics(const GeneratedModel& model) : model_(model), p
   u_.assign(model.independent, model.independent + model.independent_count);
 }
 
-void ReducedDynamics::solve(const double* u, const double* ud, const double* inputs, const double* p_in,
+namespace {
+
+Eigen::MatrixXd columns(const Eigen::MatrixXd& A, const std::vector<int>& cols) {
+  Eigen::MatrixXd C(A.rows(), static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t i = 0; i < cols.size(); ++i) C.col(i) = A.col(cols[i]);
+  return C;
+}
+
+}  // namespace
+
+void ReducedDynamics::solve(const double* u, const double* ud, const double* inputs, const double* p,
                             const Vector& guess, Result& r) const {
+  solve_kinematics(u, ud, inputs, p, guess, r);
+  solve_dynamics(inputs, p, r);
+}
+
+void ReducedDynamics::solve_kinematics(const double* u, const double* ud, const double* inputs, const double* p_in,
+                                       const Vector& guess, Result& r) const {
   const int n = model_.n, m = model_.m, nu = this->nu();
   const double* p = params(p_in);
-  const double* lam0 = pad_.data();
   std::vector<double> lam_zero(std::max(1, m), 0.0);
   r.q = guess;
   r.qd = Vector::Zero(n);
@@ -39,7 +54,6 @@ void ReducedDynamics::solve(const double* u, const double* ud, const double* inp
   for (std::size_t i = 0; i < d_.size(); ++i) {
     r.q[d_[i]] = inputs[driven_at + 3 * i];
     r.qd[d_[i]] = inputs[driven_at + 3 * i + 1];
-    r.qdd[d_[i]] = inputs[driven_at + 3 * i + 2];
   }
   const double* in = model_.inputs ? inputs : pad_.data();
 
@@ -50,11 +64,6 @@ void ReducedDynamics::solve(const double* u, const double* ud, const double* inp
     model_.constraints(r.q.data(), r.qd.data(), r.qdd.data(), lam_zero.data(), in, p, hj.data());
     for (int i = 0; i < m; ++i)
       for (int j = 0; j < n; ++j) r.J(i, j) = hj[m + i * n + j];
-  };
-  auto columns = [&](const Matrix& A, const std::vector<int>& cols) {
-    Matrix C(A.rows(), static_cast<Eigen::Index>(cols.size()));
-    for (std::size_t i = 0; i < cols.size(); ++i) C.col(i) = A.col(cols[i]);
-    return C;
   };
   r.newton_iterations = 0;
   if (m > 0) {
@@ -71,8 +80,17 @@ void ReducedDynamics::solve(const double* u, const double* ud, const double* inp
     }
     const Vector vd = r.Jv.solve(-(r.J * r.qd));
     for (int i = 0; i < m; ++i) r.qd[v_[i]] = vd[i];
-    evaluate_constraints();  // Jdot qd with the completed velocities
   }
+}
+
+void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, Result& r) const {
+  const int n = model_.n, m = model_.m, nu = this->nu();
+  const double* p = params(p_in);
+  const double* lam0 = pad_.data();
+  std::vector<double> lam_zero(std::max(1, m), 0.0);
+  const double* in = model_.inputs ? inputs : pad_.data();
+  r.qdd = Vector::Zero(n);
+  for (std::size_t i = 0; i < d_.size(); ++i) r.qdd[d_[i]] = inputs[model_.load_inputs + 3 * i + 2];
 
   // c (with the driven accelerations) and the constraint bias.
   std::vector<double> res(n + m);
@@ -142,9 +160,10 @@ void ReducedDynamics::solve(const double* u, const double* ud, const double* inp
   }
 }
 
-void ReducedDynamics::tangent(const Result& r, const double* inputs, const double* p_in, int nd, const double* du,
-                              const double* dud, const double* dinputs, const double* dp_in, Matrix& dq, Matrix& dqd,
-                              Matrix& dqdd) const {
+void ReducedDynamics::seed_kinematics(const Result& r, const double* inputs, const double* p_in, int nd,
+                                      const double* du, const double* dud, const double* dinputs,
+                                      const double* dp_in, Matrix& dq, Matrix& dqd, Matrix& dqdd, Matrix& dinp,
+                                      Matrix& dp) const {
   const int n = model_.n, m = model_.m, nu = this->nu();
   const int ni = std::max(1, model_.inputs), np = std::max(1, model_.parameters);
   const double* p = params(p_in);
@@ -152,7 +171,8 @@ void ReducedDynamics::tangent(const Result& r, const double* inputs, const doubl
   dq = Matrix::Zero(n, nd);
   dqd = Matrix::Zero(n, nd);
   dqdd = Matrix::Zero(n, nd);
-  Matrix dinp = Matrix::Zero(ni, nd), dp = Matrix::Zero(np, nd);
+  dinp = Matrix::Zero(ni, nd);
+  dp = Matrix::Zero(np, nd);
   if (dinputs && model_.inputs) dinp = Eigen::Map<const Matrix>(dinputs, model_.inputs, nd);
   if (dp_in && model_.parameters) dp = Eigen::Map<const Matrix>(dp_in, model_.parameters, nd);
   const int driven_at = model_.load_inputs;
@@ -167,7 +187,7 @@ void ReducedDynamics::tangent(const Result& r, const double* inputs, const doubl
       dqdd(d_[i], d) = dinp(driven_at + 3 * i + 2, d);
     }
   }
-  const Vector lam = m ? r.lam : Vector::Zero(1);
+  const Vector lam = r.lam.size() >= std::max(m, 1) ? r.lam : Vector::Zero(std::max(m, 1));  // not read here
   if (m > 0) {
     // dh = Ju du + Jv dv + h_p dp = 0, then d(J qd) = 0 likewise for dv_dot.
     std::vector<double> out(2 * m);
@@ -181,6 +201,24 @@ void ReducedDynamics::tangent(const Result& r, const double* inputs, const doubl
     const Matrix dvd = -r.Jv.solve(Matrix(dout.bottomRows(m)));
     for (int i = 0; i < m; ++i) dqd.row(v_[i]) = dvd.row(i);
   }
+}
+
+void ReducedDynamics::tangent_kinematics(const Result& r, const double* inputs, const double* p, int nd,
+                                         const double* du, const double* dud, const double* dinputs,
+                                         const double* dp_in, Matrix& dq, Matrix& dqd, Matrix& dqdd) const {
+  Matrix dinp, dp;
+  seed_kinematics(r, inputs, p, nd, du, dud, dinputs, dp_in, dq, dqd, dqdd, dinp, dp);
+}
+
+void ReducedDynamics::tangent(const Result& r, const double* inputs, const double* p_in, int nd, const double* du,
+                              const double* dud, const double* dinputs, const double* dp_in, Matrix& dq, Matrix& dqd,
+                              Matrix& dqdd) const {
+  const int n = model_.n, m = model_.m, nu = this->nu();
+  const double* p = params(p_in);
+  const double* in = model_.inputs ? inputs : pad_.data();
+  Matrix dinp, dp;
+  seed_kinematics(r, inputs, p_in, nd, du, dud, dinputs, dp_in, dq, dqd, dqdd, dinp, dp);
+  const Vector lam = m ? r.lam : Vector::Zero(1);
   // dr = dM qdd + dc - dJ^T lam (qdd, lam frozen; driven dqdd seeded), da = dJ qdd + d(Jdot qd).
   std::vector<double> out(n + m);
   Matrix dout(n + m, nd);

@@ -38,12 +38,23 @@ class ReducedDynamics {
   // Throws std::runtime_error when Newton-Raphson does not converge.
   void solve(const double* u, const double* ud, const double* inputs, const double* p, const Vector& guess,
              Result& r) const;
+  // solve() in its two halves. Kinematics: q, qd, J, Jv from u, u_dot, the driven joints' q and
+  // qd, p (the inputs' loads and driven accelerations are not read). Dynamics: qdd, udd, lam,
+  // B, MB, reduced at the kinematic state in r, reading the loads and driven accelerations.
+  void solve_kinematics(const double* u, const double* ud, const double* inputs, const double* p,
+                        const Vector& guess, Result& r) const;
+  void solve_dynamics(const double* inputs, const double* p, Result& r) const;
 
   // Derivatives of q, qd, qdd (n x nd each, column per direction) for seeds on u, u_dot
   // (nu x nd), inputs (inputs x nd) and parameters (parameters x nd); null seeds are zero.
   void tangent(const Result& r, const double* inputs, const double* p, int nd, const double* du,
                const double* dud, const double* dinputs, const double* dp, Matrix& dq, Matrix& dqd,
                Matrix& dqdd) const;
+  // The same for q and qd only (dqdd is left zero but for the driven joints' seeds): what
+  // positions and velocities need, without the dynamics' tangent.
+  void tangent_kinematics(const Result& r, const double* inputs, const double* p, int nd, const double* du,
+                          const double* dud, const double* dinputs, const double* dp, Matrix& dq, Matrix& dqd,
+                          Matrix& dqdd) const;
 
   const std::vector<int>& independent() const { return u_; }
   const std::vector<int>& dependent() const { return v_; }
@@ -51,6 +62,10 @@ class ReducedDynamics {
 
  private:
   const double* params(const double* p) const { return p ? p : (model_.parameters ? model_.parameter_values : pad_.data()); }
+  // Seeds dq, dqd, dqdd, dinp, dp and completes dq, dqd on the dependent coordinates.
+  void seed_kinematics(const Result& r, const double* inputs, const double* p, int nd, const double* du,
+                       const double* dud, const double* dinputs, const double* dp_in, Matrix& dq, Matrix& dqd,
+                       Matrix& dqdd, Matrix& dinp, Matrix& dp) const;
   const GeneratedModel& model_;
   std::vector<int> u_, v_, f_, d_;
   std::vector<double> pad_;  // one zero for arrays of size zero
