@@ -213,6 +213,7 @@ class Multibody : public Block {
     if (!(have_kinematics_ && kinematic == kinematic_key_)) {
       have_kinematics_ = have_dynamics_ = false;
       ++point_;
+      ++kinematic_point_;
       try {
         try {
           reduced_.solve_kinematics(e.x, e.x + nu, in.data(), p, last_q_, result_);
@@ -270,25 +271,43 @@ class Multibody : public Block {
         for (int i = 0; i < g_.parameters; ++i) dp(i, d) = s.p(i, d);
     }
     const Vector in = inputs(e);
-    if (!dynamics) {
-      reduced_.tangent_kinematics(r, in.data(), parameters(e), nd, du.data(), dud.data(), dinp.data(), dp.data(), dq,
-                                  dqd, dqdd);
-      return;
-    }
-    std::lock_guard<std::mutex> lock(mutex_);
     const auto same = [](const Matrix& a, const Matrix& b) {
       return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
     };
-    if (tangent_point_ == point_ && same(tangent_du_, du) && same(tangent_dud_, dud) &&
-        same(tangent_dinp_, dinp) && same(tangent_dp_, dp)) {
-      dq = tangent_dq_, dqd = tangent_dqd_, dqdd = tangent_dqdd_;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (dynamics && full_tangent_.point == point_ && same(full_tangent_.du, du) && same(full_tangent_.dud, dud) &&
+        same(full_tangent_.dinp, dinp) && same(full_tangent_.dp, dp)) {
+      dq = full_tangent_.dq, dqd = full_tangent_.dqd, dqdd = full_tangent_.dqdd;
       return;
     }
-    reduced_.tangent(r, in.data(), parameters(e), nd, du.data(), dud.data(), dinp.data(), dp.data(), dq, dqd, dqdd);
-    tangent_point_ = point_;
-    tangent_du_ = du, tangent_dud_ = dud, tangent_dinp_ = dinp, tangent_dp_ = dp;
-    tangent_dq_ = dq, tangent_dqd_ = dqd, tangent_dqdd_ = dqdd;
+    // Positions and velocities read the driven joints' q and qd seeds, not the loads'.
+    Matrix driven(std::max(1, 2 * g_.driven_count), std::max(nd, 1));
+    driven.setZero();
+    for (int i = 0; i < g_.driven_count; ++i)
+      for (int j = 0; j < 2; ++j) driven.row(2 * i + j) = dinp.row(g_.load_inputs + 3 * i + j);
+    if (kinematic_tangent_.point == kinematic_point_ && same(kinematic_tangent_.du, du) &&
+        same(kinematic_tangent_.dud, dud) && same(kinematic_tangent_.dinp, driven) &&
+        same(kinematic_tangent_.dp, dp)) {
+      dq = kinematic_tangent_.dq, dqd = kinematic_tangent_.dqd;
+    } else {
+      reduced_.tangent_kinematics(r, in.data(), parameters(e), nd, du.data(), dud.data(), dinp.data(), dp.data(), dq,
+                                  dqd, dqdd);
+      kinematic_tangent_ = {kinematic_point_, du, dud, driven, dp, dq, dqd, {}};
+    }
+    if (!dynamics) {
+      dqdd = Matrix::Zero(g_.n, std::max(nd, 1));  // not read: no acceleration output in this call
+      return;
+    }
+    reduced_.tangent_dynamics(r, in.data(), parameters(e), nd, dinp.data(), dp.data(), dq, dqd, dqdd);
+    full_tangent_ = {point_, du, dud, dinp, dp, dq, dqd, dqdd};
   }
+
+  /// A tangent kept for the next call at the same point with the same seeds.
+  struct KeptTangent {
+    long point = -1;
+    Matrix du, dud, dinp, dp;  ///< seeds
+    Matrix dq, dqd, dqdd;      ///< result
+  };
 
   const GeneratedModel& g_;
   ReducedDynamics reduced_;
@@ -298,9 +317,9 @@ class Multibody : public Block {
   mutable Vector last_q_, kinematic_key_, dynamic_key_;
   mutable ReducedDynamics::Result result_;
   mutable bool have_kinematics_ = false, have_dynamics_ = false;
-  mutable long point_ = 0;  ///< changes whenever result_ does
-  mutable long tangent_point_ = -1;
-  mutable Matrix tangent_du_, tangent_dud_, tangent_dinp_, tangent_dp_, tangent_dq_, tangent_dqd_, tangent_dqdd_;
+  mutable long point_ = 0;            ///< changes whenever result_ does
+  mutable long kinematic_point_ = 0;  ///< changes whenever result_'s kinematics do
+  mutable KeptTangent kinematic_tangent_, full_tangent_;
 };
 
 std::vector<engine::ParamSpec> exposed_parameters(const GeneratedModel& g) {

@@ -213,11 +213,24 @@ void ReducedDynamics::tangent_kinematics(const Result& r, const double* inputs, 
 void ReducedDynamics::tangent(const Result& r, const double* inputs, const double* p_in, int nd, const double* du,
                               const double* dud, const double* dinputs, const double* dp_in, Matrix& dq, Matrix& dqd,
                               Matrix& dqdd) const {
-  const int n = model_.n, m = model_.m, nu = this->nu();
-  const double* p = params(p_in);
-  const double* in = model_.inputs ? inputs : pad_.data();
   Matrix dinp, dp;
   seed_kinematics(r, inputs, p_in, nd, du, dud, dinputs, dp_in, dq, dqd, dqdd, dinp, dp);
+  tangent_dynamics(r, inputs, p_in, nd, dinp.data(), dp.data(), dq, dqd, dqdd);
+}
+
+void ReducedDynamics::tangent_dynamics(const Result& r, const double* inputs, const double* p_in, int nd,
+                                       const double* dinputs, const double* dp_in, const Matrix& dq,
+                                       const Matrix& dqd, Matrix& dqdd) const {
+  const int n = model_.n, m = model_.m, nu = this->nu();
+  const int ni = std::max(1, model_.inputs), np = std::max(1, model_.parameters);
+  const double* p = params(p_in);
+  const double* in = model_.inputs ? inputs : pad_.data();
+  Matrix dinp = Matrix::Zero(ni, nd), dp = Matrix::Zero(np, nd);
+  if (dinputs && model_.inputs) dinp = Eigen::Map<const Matrix>(dinputs, model_.inputs, nd);
+  if (dp_in && model_.parameters) dp = Eigen::Map<const Matrix>(dp_in, model_.parameters, nd);
+  dqdd = Matrix::Zero(n, nd);
+  for (int d = 0; d < nd; ++d)
+    for (std::size_t i = 0; i < d_.size(); ++i) dqdd(d_[i], d) = dinp(model_.load_inputs + 3 * i + 2, d);
   const Vector lam = m ? r.lam : Vector::Zero(1);
   // dr = dM qdd + dc - dJ^T lam (qdd, lam frozen; driven dqdd seeded), da = dJ qdd + d(Jdot qd).
   std::vector<double> out(n + m);

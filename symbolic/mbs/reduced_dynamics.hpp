@@ -50,6 +50,9 @@ class ReducedDynamics {
   void tangent(const Result& r, const double* inputs, const double* p, int nd, const double* du,
                const double* dud, const double* dinputs, const double* dp, Matrix& dq, Matrix& dqd,
                Matrix& dqdd) const;
+  // The dynamic half of tangent(): dqdd from dq, dqd of tangent_kinematics (same seeds).
+  void tangent_dynamics(const Result& r, const double* inputs, const double* p, int nd, const double* dinputs,
+                        const double* dp, const Matrix& dq, const Matrix& dqd, Matrix& dqdd) const;
   // The same for q and qd only (dqdd is left zero but for the driven joints' seeds): what
   // positions and velocities need, without the dynamics' tangent.
   void tangent_kinematics(const Result& r, const double* inputs, const double* p, int nd, const double* du,
