@@ -291,7 +291,7 @@ class Multibody : public Block {
       dq = kinematic_tangent_.dq, dqd = kinematic_tangent_.dqd;
     } else {
       reduced_.tangent_kinematics(r, in.data(), parameters(e), nd, du.data(), dud.data(), dinp.data(), dp.data(), dq,
-                                  dqd, dqdd);
+                                  dqd);
       kinematic_tangent_ = {kinematic_point_, du, dud, driven, dp, dq, dqd, {}};
     }
     if (!dynamics) {

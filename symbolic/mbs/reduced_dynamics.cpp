@@ -160,21 +160,27 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   }
 }
 
-void ReducedDynamics::seed_kinematics(const Result& r, const double* inputs, const double* p_in, int nd,
-                                      const double* du, const double* dud, const double* dinputs,
-                                      const double* dp_in, Matrix& dq, Matrix& dqd, Matrix& dqdd, Matrix& dinp,
-                                      Matrix& dp) const {
-  const int n = model_.n, m = model_.m, nu = this->nu();
-  const int ni = std::max(1, model_.inputs), np = std::max(1, model_.parameters);
-  const double* p = params(p_in);
-  const double* in = model_.inputs ? inputs : pad_.data();
-  dq = Matrix::Zero(n, nd);
-  dqd = Matrix::Zero(n, nd);
-  dqdd = Matrix::Zero(n, nd);
-  dinp = Matrix::Zero(ni, nd);
-  dp = Matrix::Zero(np, nd);
+void ReducedDynamics::seed_arrays(int nd, const double* dinputs, const double* dp_in, Matrix& dinp, Matrix& dp,
+                                  Matrix& dqdd) const {
+  dinp = Matrix::Zero(std::max(1, model_.inputs), nd);
+  dp = Matrix::Zero(std::max(1, model_.parameters), nd);
   if (dinputs && model_.inputs) dinp = Eigen::Map<const Matrix>(dinputs, model_.inputs, nd);
   if (dp_in && model_.parameters) dp = Eigen::Map<const Matrix>(dp_in, model_.parameters, nd);
+  dqdd = Matrix::Zero(model_.n, nd);
+  for (int d = 0; d < nd; ++d)
+    for (std::size_t i = 0; i < d_.size(); ++i) dqdd(d_[i], d) = dinp(model_.load_inputs + 3 * i + 2, d);
+}
+
+void ReducedDynamics::tangent_kinematics(const Result& r, const double* inputs, const double* p_in, int nd,
+                                         const double* du, const double* dud, const double* dinputs,
+                                         const double* dp_in, Matrix& dq, Matrix& dqd) const {
+  const int n = model_.n, m = model_.m, nu = this->nu();
+  const double* p = params(p_in);
+  const double* in = model_.inputs ? inputs : pad_.data();
+  Matrix dinp, dp, dqdd;
+  seed_arrays(nd, dinputs, dp_in, dinp, dp, dqdd);
+  dq = Matrix::Zero(n, nd);
+  dqd = Matrix::Zero(n, nd);
   const int driven_at = model_.load_inputs;
   for (int d = 0; d < nd; ++d) {
     for (int i = 0; i < nu; ++i) {
@@ -184,7 +190,6 @@ void ReducedDynamics::seed_kinematics(const Result& r, const double* inputs, con
     for (std::size_t i = 0; i < d_.size(); ++i) {
       dq(d_[i], d) = dinp(driven_at + 3 * i, d);
       dqd(d_[i], d) = dinp(driven_at + 3 * i + 1, d);
-      dqdd(d_[i], d) = dinp(driven_at + 3 * i + 2, d);
     }
   }
   const Vector lam = r.lam.size() >= std::max(m, 1) ? r.lam : Vector::Zero(std::max(m, 1));  // not read here
@@ -203,34 +208,21 @@ void ReducedDynamics::seed_kinematics(const Result& r, const double* inputs, con
   }
 }
 
-void ReducedDynamics::tangent_kinematics(const Result& r, const double* inputs, const double* p, int nd,
-                                         const double* du, const double* dud, const double* dinputs,
-                                         const double* dp_in, Matrix& dq, Matrix& dqd, Matrix& dqdd) const {
-  Matrix dinp, dp;
-  seed_kinematics(r, inputs, p, nd, du, dud, dinputs, dp_in, dq, dqd, dqdd, dinp, dp);
-}
-
-void ReducedDynamics::tangent(const Result& r, const double* inputs, const double* p_in, int nd, const double* du,
-                              const double* dud, const double* dinputs, const double* dp_in, Matrix& dq, Matrix& dqd,
+void ReducedDynamics::tangent(const Result& r, const double* inputs, const double* p, int nd, const double* du,
+                              const double* dud, const double* dinputs, const double* dp, Matrix& dq, Matrix& dqd,
                               Matrix& dqdd) const {
-  Matrix dinp, dp;
-  seed_kinematics(r, inputs, p_in, nd, du, dud, dinputs, dp_in, dq, dqd, dqdd, dinp, dp);
-  tangent_dynamics(r, inputs, p_in, nd, dinp.data(), dp.data(), dq, dqd, dqdd);
+  tangent_kinematics(r, inputs, p, nd, du, dud, dinputs, dp, dq, dqd);
+  tangent_dynamics(r, inputs, p, nd, dinputs, dp, dq, dqd, dqdd);
 }
 
 void ReducedDynamics::tangent_dynamics(const Result& r, const double* inputs, const double* p_in, int nd,
                                        const double* dinputs, const double* dp_in, const Matrix& dq,
                                        const Matrix& dqd, Matrix& dqdd) const {
   const int n = model_.n, m = model_.m, nu = this->nu();
-  const int ni = std::max(1, model_.inputs), np = std::max(1, model_.parameters);
   const double* p = params(p_in);
   const double* in = model_.inputs ? inputs : pad_.data();
-  Matrix dinp = Matrix::Zero(ni, nd), dp = Matrix::Zero(np, nd);
-  if (dinputs && model_.inputs) dinp = Eigen::Map<const Matrix>(dinputs, model_.inputs, nd);
-  if (dp_in && model_.parameters) dp = Eigen::Map<const Matrix>(dp_in, model_.parameters, nd);
-  dqdd = Matrix::Zero(n, nd);
-  for (int d = 0; d < nd; ++d)
-    for (std::size_t i = 0; i < d_.size(); ++i) dqdd(d_[i], d) = dinp(model_.load_inputs + 3 * i + 2, d);
+  Matrix dinp, dp;
+  seed_arrays(nd, dinputs, dp_in, dinp, dp, dqdd);
   const Vector lam = m ? r.lam : Vector::Zero(1);
   // dr = dM qdd + dc - dJ^T lam (qdd, lam frozen; driven dqdd seeded), da = dJ qdd + d(Jdot qd).
   std::vector<double> out(n + m);

@@ -53,11 +53,10 @@ class ReducedDynamics {
   // The dynamic half of tangent(): dqdd from dq, dqd of tangent_kinematics (same seeds).
   void tangent_dynamics(const Result& r, const double* inputs, const double* p, int nd, const double* dinputs,
                         const double* dp, const Matrix& dq, const Matrix& dqd, Matrix& dqdd) const;
-  // The same for q and qd only (dqdd is left zero but for the driven joints' seeds): what
-  // positions and velocities need, without the dynamics' tangent.
+  // The kinematic half of tangent(): dq and dqd only, what positions and velocities need.
   void tangent_kinematics(const Result& r, const double* inputs, const double* p, int nd, const double* du,
-                          const double* dud, const double* dinputs, const double* dp, Matrix& dq, Matrix& dqd,
-                          Matrix& dqdd) const;
+                          const double* dud, const double* dinputs, const double* dp, Matrix& dq,
+                          Matrix& dqd) const;
 
   const std::vector<int>& independent() const { return u_; }
   const std::vector<int>& dependent() const { return v_; }
@@ -65,10 +64,10 @@ class ReducedDynamics {
 
  private:
   const double* params(const double* p) const { return p ? p : (model_.parameters ? model_.parameter_values : pad_.data()); }
-  // Seeds dq, dqd, dqdd, dinp, dp and completes dq, dqd on the dependent coordinates.
-  void seed_kinematics(const Result& r, const double* inputs, const double* p, int nd, const double* du,
-                       const double* dud, const double* dinputs, const double* dp_in, Matrix& dq, Matrix& dqd,
-                       Matrix& dqdd, Matrix& dinp, Matrix& dp) const;
+  // The input and parameter seeds as padded matrices (null: zero), and dqdd seeded on the
+  // driven joints' accelerations.
+  void seed_arrays(int nd, const double* dinputs, const double* dp, Matrix& dinp, Matrix& dp_out,
+                   Matrix& dqdd) const;
   const GeneratedModel& model_;
   std::vector<int> u_, v_, f_, d_;
   std::vector<double> pad_;  // one zero for arrays of size zero

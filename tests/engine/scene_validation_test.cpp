@@ -594,29 +594,26 @@ outputs: [src.y]
   expect_error(load_error(path), path, 5, "solver.method", "unknown method 'euler'");
 }
 
-TEST_F(SceneValidation, NonPositiveTolerance) {
-  const std::string path = write("s.yaml", R"(scene: t
+/// A scene whose solver block has `method: bdf` and then `setting` on line 5.
+std::string scene_with_solver_setting(const std::string& setting) {
+  return R"(scene: t
 time: {stop: 1.0, output_step: 0.1}
 solver:
   method: bdf
-  atol: -1.0e-8
+  )" + setting + R"(
 blocks:
   src: {type: source.sine}
 outputs: [src.y]
-)");
+)";
+}
+
+TEST_F(SceneValidation, NonPositiveTolerance) {
+  const std::string path = write("s.yaml", scene_with_solver_setting("atol: -1.0e-8"));
   expect_error(load_error(path), path, 5, "solver.atol", "must be positive");
 }
 
 TEST_F(SceneValidation, NegativeMinStep) {
-  const std::string path = write("s.yaml", R"(scene: t
-time: {stop: 1.0, output_step: 0.1}
-solver:
-  method: bdf
-  min_step: -1.0e-12
-blocks:
-  src: {type: source.sine}
-outputs: [src.y]
-)");
+  const std::string path = write("s.yaml", scene_with_solver_setting("min_step: -1.0e-12"));
   expect_error(load_error(path), path, 5, "solver.min_step", "must not be negative");
 }
 
