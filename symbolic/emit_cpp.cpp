@@ -303,6 +303,26 @@ std::string input_parameters(const Context& ctx) {
   return s;
 }
 
+// A signature wrapped after its commas so that no line passes 100 characters.
+std::string wrapped_signature(const std::string& signature) {
+  std::string s;
+  std::size_t line = 0;
+  std::size_t at = 0;
+  while (at < signature.size()) {
+    std::size_t next = signature.find(", ", at);
+    const std::string piece = next == std::string::npos ? signature.substr(at) : signature.substr(at, next + 2 - at);
+    if (line > 0 && line + piece.size() > 100) {
+      s.back() = '\n';  // the space after the comma
+      s += "    ";
+      line = 4;
+    }
+    s += piece;
+    line += piece.size();
+    at = next == std::string::npos ? signature.size() : next + 2;
+  }
+  return s;
+}
+
 std::string linkage(const EmitOptions& options) { return options.extern_c ? "extern \"C\" " : ""; }
 
 std::string summary(const EquationList& list, const std::string& name) {
@@ -348,7 +368,7 @@ EmittedFunction emit_function(const EquationList& list, const EmitOptions& optio
   const Printer printer(ctx);
   const std::string signature = linkage(options) + "void " + options.function_name + "(" +
                                 input_parameters(ctx) + "double* out) noexcept";
-  std::string body = summary(list, options.function_name) + signature + "\n{\n";
+  std::string body = summary(list, options.function_name) + wrapped_signature(signature) + "\n{\n";
   write_prologue(list, printer, body);
   write_assignments(list, printer, 0, list.size(), "  ", body);
   for (std::size_t j = 0; j < list.outputs().size(); ++j) {
@@ -358,7 +378,7 @@ EmittedFunction emit_function(const EquationList& list, const EmitOptions& optio
     body += ";  // " + one_line(o.name) + "\n";
   }
   body += "}\n";
-  return EmittedFunction{options.function_name, signature + ";\n", body};
+  return EmittedFunction{options.function_name, wrapped_signature(signature) + ";\n", body};
 }
 
 EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayId> seeded_arrays,
@@ -377,7 +397,7 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
   std::string body = summary(tangent, options.function_name) +
                      "// primal once, then the derivative part once per direction d < nd;\n"
                      "// seed (i, d) at seed_x[d*n + i], derivative (j, d) at dout[d*" +
-                     std::to_string(derivative_outputs) + " + j]\n" + signature + "\n{\n";
+                     std::to_string(derivative_outputs) + " + j]\n" + wrapped_signature(signature) + "\n{\n";
   write_prologue(tangent, printer, body);
   write_assignments(tangent, printer, 0, tangent.primal_assignments(), "  ", body);
   for (std::size_t j = 0; j < primal_outputs; ++j) {
@@ -400,7 +420,7 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
     body += ";  // " + one_line(o.name) + "\n";
   }
   body += "  }\n}\n";
-  return EmittedFunction{options.function_name, signature + ";\n", body};
+  return EmittedFunction{options.function_name, wrapped_signature(signature) + ";\n", body};
 }
 
 std::string emit_header_file(std::span<const EmittedFunction> functions, const EmitOptions& options) {

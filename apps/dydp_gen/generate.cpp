@@ -4,7 +4,9 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <unordered_set>
 
+#include "symbolic/compact.hpp"
 #include "symbolic/differentiate.hpp"
 #include "symbolic/eliminate.hpp"
 #include "symbolic/emit_cpp.hpp"
@@ -26,6 +28,22 @@ void write_atomically(const std::filesystem::path& path, const std::string& text
   std::filesystem::rename(temporary, path);
 }
 
+void measure_text(const std::string& definition, FunctionStats& stats) {
+  std::istringstream lines(definition);
+  std::unordered_set<std::string> right_hand_sides;
+  std::string line;
+  stats.longest_line = 0;
+  stats.repeated_right_hand_sides = 0;
+  while (std::getline(lines, line)) {
+    stats.longest_line = std::max(stats.longest_line, line.size());
+    const std::size_t start = line.find_first_not_of(' ');
+    if (start == std::string::npos || line.compare(start, 13, "const double ") != 0) continue;
+    const std::size_t equals = line.find(" = ", start);
+    if (equals == std::string::npos) continue;
+    if (!right_hand_sides.insert(line.substr(equals + 3)).second) ++stats.repeated_right_hand_sides;
+  }
+}
+
 std::vector<FunctionStats> generate(const GenerationInput& input, const GenerationOptions& options) {
   if (!input.list) throw std::invalid_argument("generate: no equation list");
   EliminationStats elimination;
@@ -45,20 +63,24 @@ std::vector<FunctionStats> generate(const GenerationInput& input, const Generati
   };
 
   emit.function_name = input.name;
-  const EquationList primal = options.expand ? expand(kept) : kept;
+  const EquationList primal = options.expand ? expand(kept) : compact(kept);
   functions.push_back(emit_function(primal, emit));
   record(input.name, before, primal);
+  measure_text(functions.back().definition, stats.back());
 
   if (!input.tangent_arrays.empty()) {
     // as tangent_list, keeping the size before elimination for the statistics
     const Direction direction = seeded(kept.context(), input.tangent_arrays);
     EliminationStats tangent_elimination;
+    // the recursive form differentiates the compact scheme, so the tangent's size follows it
+    const EquationList source = options.expand ? kept : compact(kept);
     const EquationList tangent =
-        eliminate(differentiate(kept, std::span<const Direction>(&direction, 1)), &tangent_elimination);
-    const EquationList written = options.expand ? expand(tangent) : tangent;
+        eliminate(differentiate(source, std::span<const Direction>(&direction, 1)), &tangent_elimination);
+    const EquationList written = options.expand ? expand(tangent) : compact(tangent);
     emit.function_name = input.name + "_tangent";
     functions.push_back(emit_tangent(written, input.tangent_arrays, emit));
     record(emit.function_name, tangent_elimination.before, written);
+    measure_text(functions.back().definition, stats.back());
   }
 
   std::filesystem::create_directories(options.out_dir);
@@ -76,7 +98,8 @@ std::string stats_json(const std::vector<FunctionStats>& functions, double secon
     s << (i ? ",\n" : "\n") << "    \"" << f.name << "\": {\"equations_before\": " << f.equations_before
       << ", \"equations_after\": " << f.equations_after << ", \"ops\": {\"add\": " << f.ops.add
       << ", \"mul\": " << f.ops.mul << ", \"div\": " << f.ops.div << ", \"call\": " << f.ops.call
-      << "}, \"ops_total\": " << f.ops.total() << "}";
+      << "}, \"ops_total\": " << f.ops.total() << ", \"longest_line\": " << f.longest_line
+      << ", \"repeated_right_hand_sides\": " << f.repeated_right_hand_sides << "}";
   }
   s.precision(6);
   s << "\n  },\n";

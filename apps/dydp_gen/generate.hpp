@@ -24,7 +24,14 @@ struct FunctionStats {
   std::size_t equations_before = 0;
   std::size_t equations_after = 0;
   symbolic::OpCount ops;
+  // Read off the emitted text: the longest line, and assignments whose right-hand side repeats
+  // an earlier assignment's in the same function.
+  std::size_t longest_line = 0;
+  std::size_t repeated_right_hand_sides = 0;
 };
+
+// longest_line and repeated_right_hand_sides of one emitted function's text.
+void measure_text(const std::string& definition, FunctionStats& stats);
 
 struct GenerationOptions {
   std::filesystem::path out_dir;

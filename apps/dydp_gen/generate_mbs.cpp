@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <sstream>
 
+#include "symbolic/compact.hpp"
 #include "symbolic/differentiate.hpp"
 #include "symbolic/eliminate.hpp"
 #include "symbolic/emit_cpp.hpp"
@@ -20,7 +21,7 @@ using namespace dydp::symbolic;
 
 std::string string_array(const std::string& name, const std::vector<std::string>& items) {
   std::string s = "const char* const " + name + "[] = {";
-  for (const auto& i : items) s += "\"" + i + "\", ";
+  for (std::size_t k = 0; k < items.size(); ++k) s += std::string(k % 6 ? "" : "\n    ") + "\"" + items[k] + "\", ";
   if (items.empty()) s += "nullptr";
   return s + "};\n";
 }
@@ -55,7 +56,7 @@ std::string number_array(const std::string& type, const std::string& name, const
   std::ostringstream s;
   s.precision(17);
   s << "const " << type << " " << name << "[] = {";
-  for (const auto& i : items) s << i << ", ";
+  for (std::size_t k = 0; k < items.size(); ++k) s << (k % 8 ? "" : "\n    ") << items[k] << ", ";
   if (items.empty()) s << "0";
   s << "};\n";
   return s.str();
@@ -110,18 +111,24 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
 
   auto plain = [&](const std::string& fn, const EquationList& list, bool expanded = false) {
     emit.function_name = fn;
-    const EquationList written = expanded ? expand(list) : list;
+    const EquationList written = expanded ? expand(list) : compact(list);
     result.functions.push_back({fn, lists.assignments_built, expanded ? written.outputs().size() : written.size(),
                                 count_ops(written)});
-    return emit_function(written, emit);
+    EmittedFunction f = emit_function(written, emit);
+    measure_text(f.definition, result.functions.back());
+    return f;
   };
   auto tangent = [&](const std::string& fn, const EquationList& list, std::vector<ArrayId> arrays) {
     const Direction direction = seeded(list.context(), arrays);
     EliminationStats stats;
-    const EquationList t = eliminate(differentiate(list, std::span<const Direction>(&direction, 1)), &stats);
+    // differentiated from the compact scheme, so the tangent's size follows the primal's
+    const EquationList t =
+        compact(eliminate(differentiate(compact(list), std::span<const Direction>(&direction, 1)), &stats));
     emit.function_name = fn;
     result.functions.push_back({fn, stats.before, t.size(), count_ops(t)});
-    return emit_tangent(t, arrays, emit);
+    EmittedFunction f = emit_tangent(t, arrays, emit);
+    measure_text(f.definition, result.functions.back());
+    return f;
   };
   auto seeded_fn = [&](const std::string& fn, const EquationList& list, std::vector<ArrayId> arrays) {
     return tangent(fn, list, std::move(arrays));

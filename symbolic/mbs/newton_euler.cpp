@@ -6,7 +6,9 @@
 #include "symbolic/mbs/newton_euler.hpp"
 
 #include <array>
+#include <map>
 
+#include "symbolic/compact.hpp"
 #include "symbolic/differentiate.hpp"
 #include "symbolic/eliminate.hpp"
 
@@ -94,7 +96,8 @@ class Generator {
 
     // Constraint derivatives: along time with qdd (accelerations), along time with qdd = 0
     // (Jdot qd), along every q (J).
-    const EquationList h_list = symbolic::eliminate(with_outputs(*all_, outputs("h", h)));
+    // the constraints' derivatives are taken on the compact scheme, so their size follows it
+    const EquationList h_list = symbolic::compact(symbolic::eliminate(with_outputs(*all_, outputs("h", h))));
     Direction time_full{"t", "t", {}}, time_velocity{"v", "v", {}};
     std::vector<Direction> along_q;
     for (int j = 0; j < n; ++j) {
@@ -148,24 +151,23 @@ class Generator {
   }
 
  private:
-  // One list from the recursive scheme (the part `base_outputs` and every list's primal part
-  // need) followed by the derivative assignments of the differentiated lists, eliminated.
-  // Each differentiated list's primal part is an elimination of the scheme, so its
-  // assignments are either in the scheme or derivative assignments.
+  // One list from the recursive scheme (the part `base_outputs` needs) followed by every
+  // assignment of the given lists not already in it (their primal parts are compactions of the
+  // scheme, their derivative parts new), eliminated. An assignment reads only earlier ones of
+  // its own list, which are placed before it.
   std::unique_ptr<EquationList> merged(std::vector<Output> base_outputs, std::vector<const EquationList*> lists,
                                        std::vector<Output> outputs) {
-    const std::size_t primal = lists.front()->size();
-    for (const auto& o : lists.front()->outputs()) base_outputs.push_back(o);
     const EquationList base = symbolic::eliminate(with_outputs(*all_, std::move(base_outputs)));
     EquationList list(*ctx_);
-    for (const auto& a : base.assignments()) list.append(a);
     std::vector<bool> seen(ctx_->size(), false);
-    for (const auto& a : base.assignments()) seen[a.target] = true;
+    for (const auto& a : base.assignments()) {
+      list.append(a);
+      seen[a.target] = true;
+    }
     for (const EquationList* l : lists) {
-      for (std::size_t i = primal; i < l->size(); ++i) {
-        const auto& a = l->assignments()[i];
-        if (a.target < seen.size() && seen[a.target]) continue;
+      for (const auto& a : l->assignments()) {
         if (a.target >= seen.size()) seen.resize(ctx_->size(), false);
+        if (seen[a.target]) continue;
         seen[a.target] = true;
         list.append(a);
       }
@@ -202,7 +204,7 @@ class Generator {
     const Joint& j = m_.joints[k];
     if (!is_revolute(j.type)) return v;
     if (axis_of(j.type) < 0) {
-      const auto& R = relative_[k];
+      const auto& R = relative_rotation_[k];
       V3 r;
       for (int i = 0; i < 3; ++i) r[i] = R[i][0] * v[0] + R[i][1] * v[1] + R[i][2] * v[2];
       return r;
@@ -218,7 +220,7 @@ class Generator {
     const Joint& j = m_.joints[k];
     if (!is_revolute(j.type)) return v;
     if (axis_of(j.type) < 0) {
-      const auto& R = relative_[k];
+      const auto& R = relative_rotation_[k];
       V3 r;
       for (int i = 0; i < 3; ++i) r[i] = R[0][i] * v[0] + R[1][i] * v[1] + R[2][i] * v[2];
       return r;
@@ -244,7 +246,7 @@ class Generator {
     rot_.resize(n);
     origin_.resize(n);
     offset_.resize(n);
-    relative_.resize(n);
+    relative_rotation_.resize(n);
     for (int k = 0; k < n; ++k) {
       cos_.push_back(symbolic::cos(ctx_->element(out_.q, k)));
       sin_.push_back(symbolic::sin(ctx_->element(out_.q, k)));
@@ -256,7 +258,7 @@ class Generator {
       const Expr versine = all_->assign("VC" + std::to_string(k + 1), 1.0 - cos_[k]);
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c)
-          relative_[k][r][c] = all_->assign("RJ" + std::to_string(r + 1) + std::to_string(c + 1) + "_" + std::to_string(k + 1),
+          relative_rotation_[k][r][c] = all_->assign("RJ" + std::to_string(r + 1) + std::to_string(c + 1) + "_" + std::to_string(k + 1),
                                             (r == c ? cos_[k] : ctx_->zero()) + skew[r][c] * sin_[k] +
                                                 (a[r] * a[c]) * versine);
     }
@@ -268,8 +270,8 @@ class Generator {
       Rot r = parent;
       if (is_revolute(j.type) && axis_of(j.type) < 0) {
         for (int c = 0; c < 3; ++c)
-          r.col[c] = relative_[k][0][c] * parent.col[0] + relative_[k][1][c] * parent.col[1] +
-                     relative_[k][2][c] * parent.col[2];
+          r.col[c] = relative_rotation_[k][0][c] * parent.col[0] + relative_rotation_[k][1][c] * parent.col[1] +
+                     relative_rotation_[k][2][c] * parent.col[2];
       } else if (is_revolute(j.type)) {
         const int a = axis_of(j.type), i = (a + 1) % 3, l = (a + 2) % 3;
         r.col[i] = cos_[k] * parent.col[i] + sin_[k] * parent.col[l];
@@ -381,12 +383,17 @@ class Generator {
         }
       }
       int row = 0;
-      for (const Cut& c : m_.cuts) {
+      for (std::size_t ci = 0; ci < m_.cuts.size(); ++ci) {
+        const Cut& c = m_.cuts[ci];
+        // ball and hinge rows are components in the cut's frame; its force in ground components
+        const Rot frame = frame_rotation(cut_frame(c));
         V3 f = zero3();
         if (c.type == Cut::Type::Ball) {
           for (int comp : c.components) f[comp] = ctx_->element(out_.lam, row++);
+          f = frame.apply(f);
         } else if (c.type == Cut::Type::Hinge) {
           for (int comp = 0; comp < 3; ++comp) f[comp] = ctx_->element(out_.lam, row++);
+          f = frame.apply(f);
           // The alignment rows h = (R_a n) . (R_b axis_b) vary by (dtheta_b - dtheta_a) . (b x n):
           // their multipliers are the torques lam (b x n) on b and the opposite on a.
           const HingeAxes axes = hinge_axes(c);
@@ -396,9 +403,8 @@ class Generator {
           if (c.b.body != 0) ext_n[c.b.body] = ext_n[c.b.body] + body_rotation(c.b.body).apply_transpose(torque);
           if (c.a.body != 0) ext_n[c.a.body] = ext_n[c.a.body] - body_rotation(c.a.body).apply_transpose(torque);
         } else {
-          const V3 d = point_position(c.b) - point_position(c.a);
-          const Expr length = all_->assign("LC" + std::to_string(row + 1), symbolic::sqrt(dot(d, d)));
-          f = (ctx_->element(out_.lam, row++) / length) * d;
+          // h = (d.d - L^2) / 2L: J^T lam is the force (lam / L) d on b
+          f = frame.apply((ctx_->element(out_.lam, row++) / val(c.length)) * cut_vector(ci));
         }
         apply(c.b, f);
         apply(c.a, -f);
@@ -457,11 +463,16 @@ class Generator {
     return q_force;
   }
 
+  // Every cut's equations are written in the frame of the nearest joint frame that carries both
+  // of its bodies (for a suspension corner, the chassis), so that they do not depend on the
+  // coordinates above it: J has zero columns there and each loop's rows read its own
+  // coordinates only. A ball cut that keeps a subset of components stays in ground components.
   std::vector<Expr> constraint_values() {
     std::vector<Expr> h;
     int row = 0;
-    for (const Cut& c : m_.cuts) {
-      const V3 d = point_position(c.b) - point_position(c.a);
+    for (std::size_t ci = 0; ci < m_.cuts.size(); ++ci) {
+      const Cut& c = m_.cuts[ci];
+      const V3 d = cut_vector(ci);
       if (c.type == Cut::Type::Ball) {
         for (int comp : c.components) h.push_back(all_->assign("H" + std::to_string(++row), d[comp]));
       } else if (c.type == Cut::Type::Hinge) {
@@ -469,10 +480,72 @@ class Generator {
         const HingeAxes axes = hinge_axes(c);
         for (const V3& normal : axes.normals) h.push_back(all_->assign("H" + std::to_string(++row), dot(normal, axes.b)));
       } else {
-        h.push_back(all_->assign("H" + std::to_string(++row), symbolic::sqrt(dot(d, d)) - val(c.length)));
+        // |d| = L without a square root: (d.d - L^2) / 2L, with the same Jacobian on |d| = L
+        const Expr length = val(c.length);
+        h.push_back(all_->assign("H" + std::to_string(++row), (dot(d, d) - length * length) * (0.5 / length)));
       }
     }
     return h;
+  }
+
+  // The nearest common ancestor of two joint frames (-1: the ground).
+  int common_frame(int fa, int fb) const {
+    std::vector<char> above(m_.coordinates(), 0);
+    for (int k = fa; k >= 0; k = m_.joints[k].parent) above[k] = 1;
+    int k = fb;
+    while (k >= 0 && !above[k]) k = m_.joints[k].parent;
+    return k;
+  }
+  int cut_frame(const Cut& c) const {
+    if (c.type == Cut::Type::Ball && c.components.size() < 3) return -1;
+    return common_frame(m_.bodies[c.a.body].frame, m_.bodies[c.b.body].frame);
+  }
+  Rot frame_rotation(int frame) { return frame < 0 ? Rot{{unit(0), unit(1), unit(2)}} : rot_[frame]; }
+
+  // Rotation and origin of joint frame k relative to its ancestor frame c, in c's components,
+  // by the same recursion as the absolute ones (positions()), started at c.
+  struct Placement {
+    Rot rot;
+    V3 origin;
+  };
+  Placement relative_placement(int k, int c) {
+    if (c < 0) return {rot_[k], origin_[k]};
+    if (k == c) return {Rot{{unit(0), unit(1), unit(2)}}, zero3()};
+    const auto key = std::make_pair(k, c);
+    if (const auto it = relative_.find(key); it != relative_.end()) return it->second;
+    const Joint& j = m_.joints[k];
+    const Placement parent = relative_placement(j.parent, c);
+    Rot r = parent.rot;
+    if (is_revolute(j.type) && axis_of(j.type) < 0) {
+      for (int col = 0; col < 3; ++col)
+        r.col[col] = relative_rotation_[k][0][col] * parent.rot.col[0] + relative_rotation_[k][1][col] * parent.rot.col[1] +
+                     relative_rotation_[k][2][col] * parent.rot.col[2];
+    } else if (is_revolute(j.type)) {
+      const int a = axis_of(j.type), i = (a + 1) % 3, l = (a + 2) % 3;
+      r.col[i] = cos_[k] * parent.rot.col[i] + sin_[k] * parent.rot.col[l];
+      r.col[l] = -sin_[k] * parent.rot.col[i] + cos_[k] * parent.rot.col[l];
+    }
+    const std::string tag = std::to_string(k + 1) + "_" + std::to_string(c + 1);
+    for (int col = 0; col < 3; ++col) r.col[col] = assign("RL" + std::to_string(col + 1) + "_" + tag + "_", 0, r.col[col]);
+    const V3 origin = assign("XL_" + tag + "_", 0, parent.origin + parent.rot.apply(offset_[k]));
+    return relative_[key] = Placement{r, origin};
+  }
+  // A point in the components of frame c (an ancestor of its body's frame), from c's origin.
+  V3 point_in(PointRef p, int c) {
+    const int f = m_.bodies[p.body].frame;
+    if (c < 0) return point_position(p);
+    const Placement placement = relative_placement(f, c);
+    return placement.origin + placement.rot.apply(anchor(p));
+  }
+  // b - a of cut i in the cut's frame (assigned once).
+  V3 cut_vector(std::size_t i) {
+    if (cut_vectors_.size() < m_.cuts.size()) cut_vectors_.resize(m_.cuts.size());
+    if (!cut_vectors_[i].c[0].valid()) {
+      const Cut& c = m_.cuts[i];
+      const int frame = cut_frame(c);
+      cut_vectors_[i] = assign("DC", static_cast<int>(i), point_in(c.b, frame) - point_in(c.a, frame));
+    }
+    return cut_vectors_[i];
   }
 
   // A hinge cut's axes in ground components: axis_b carried by b's body, the normals of axis_a
@@ -540,7 +613,9 @@ class Generator {
   std::unique_ptr<EquationList> all_;
   std::vector<int> param_index_;
   std::vector<Expr> cos_, sin_;
-  std::vector<std::array<std::array<Expr, 3>, 3>> relative_;  // R of joints about arbitrary axes
+  std::vector<std::array<std::array<Expr, 3>, 3>> relative_rotation_;  // R of joints about arbitrary axes
+  std::map<std::pair<int, int>, Placement> relative_;  // frame k relative to its ancestor c
+  std::vector<V3> cut_vectors_;
   std::vector<Rot> rot_;
   std::vector<V3> origin_, offset_, omega_, velocity_, full_alpha_, full_acc_;
 };

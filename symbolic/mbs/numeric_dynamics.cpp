@@ -136,25 +136,28 @@ NumericDynamics::Vector NumericDynamics::residual(const Vector& q, const Vector&
   }
   int row = 0;
   for (const Cut& c : model_.cuts) {
+    const M3 Rc = cut_rotation(k, c);
     if (c.type == Cut::Type::Ball) {
       V3 f = V3::Zero();
       for (int comp : c.components) f[comp] = lam.size() ? lam[row++] : 0.0;
-      apply(c.b, f);
-      apply(c.a, -f);
+      apply(c.b, Rc * f);
+      apply(c.a, -(Rc * f));
     } else if (c.type == Cut::Type::Hinge) {
       // a force at the joined points and a torque normal to the hinge axis: the virtual work of
       // lam on the constraint variations dh (see constraint_jacobian)
       V3 f = V3::Zero(), moment = V3::Zero();
       const HingeFrame axes = hinge_frame(k, c);
       for (int comp = 0; comp < 3; ++comp) f[comp] = lam.size() ? lam[row++] : 0.0;
+      f = Rc * f;
       for (const V3& normal : axes.normals) moment += (lam.size() ? lam[row++] : 0.0) * axes.b.cross(normal);
       apply(c.b, f);
       apply(c.a, -f);
       if (c.b.body != 0) torque[c.b.body] += moment;
       if (c.a.body != 0) torque[c.a.body] -= moment;
     } else {
+      // h = (d.d - L^2) / 2L, whose gradient is d / L
       const V3 d = point_position(k, c.b) - point_position(k, c.a);
-      const V3 f = (lam.size() ? lam[row++] : 0.0) * d / d.norm();
+      const V3 f = (lam.size() ? lam[row++] : 0.0) * d / value(c.length);
       apply(c.b, f);
       apply(c.a, -f);
     }
@@ -236,14 +239,16 @@ NumericDynamics::Vector NumericDynamics::constraints(const Vector& q) const {
   int row = 0;
   for (const Cut& c : model_.cuts) {
     const V3 d = point_position(k, c.b) - point_position(k, c.a);
+    const V3 dc = cut_rotation(k, c).transpose() * d;  // in the cut's frame
     if (c.type == Cut::Type::Ball) {
-      for (int comp : c.components) h[row++] = d[comp];
+      for (int comp : c.components) h[row++] = dc[comp];
     } else if (c.type == Cut::Type::Hinge) {
       const HingeFrame axes = hinge_frame(k, c);
-      for (int comp = 0; comp < 3; ++comp) h[row++] = d[comp];
+      for (int comp = 0; comp < 3; ++comp) h[row++] = dc[comp];
       for (const V3& normal : axes.normals) h[row++] = normal.dot(axes.b);
     } else {
-      h[row++] = d.norm() - value(c.length);
+      const double length = value(c.length);
+      h[row++] = (d.squaredNorm() - length * length) / (2.0 * length);
     }
   }
   return h;
@@ -283,16 +288,46 @@ NumericDynamics::Matrix NumericDynamics::angular_jacobian(const Kinematics& k, i
   return J;
 }
 
+int NumericDynamics::cut_frame(const Cut& c) const {
+  if (c.type == Cut::Type::Ball && c.components.size() < 3) return -1;
+  const int fa = model_.bodies[c.a.body].frame, fb = model_.bodies[c.b.body].frame;
+  for (int k = fb; k >= 0; k = model_.joints[k].parent)
+    if (fa >= 0 && is_ancestor(k, fa)) return k;
+  return -1;
+}
+
+NumericDynamics::M3 NumericDynamics::cut_rotation(const Kinematics& k, const Cut& c) const {
+  const int frame = cut_frame(c);
+  return frame < 0 ? M3(M3::Identity()) : k.rotation[frame];
+}
+
+NumericDynamics::Matrix NumericDynamics::frame_angular_jacobian(const Kinematics& k, int frame) const {
+  Matrix J = Matrix::Zero(3, n());
+  for (int j = 0; j < n(); ++j) {
+    const Joint& joint = model_.joints[j];
+    if (frame < 0 || !is_revolute(joint.type) || !is_ancestor(j, frame)) continue;
+    const M3 Rp = joint.parent >= 0 ? k.rotation[joint.parent] : M3::Identity();
+    J.col(j) = Rp * axis_of_joint(joint);
+  }
+  return J;
+}
+
 NumericDynamics::Matrix NumericDynamics::constraint_jacobian(const Vector& q) const {
   const Kinematics k = kinematics(q, Vector::Zero(n()), Vector::Zero(n()));
   Matrix J(m(), n());
   int row = 0;
   for (const Cut& c : model_.cuts) {
     const Matrix Jd = point_jacobian(q, c.b) - point_jacobian(q, c.a);
+    // d(Rc^T d)/dq_j = Rc^T (dd/dq_j - w_j x d), w_j the turn of the cut's frame per unit q_j
+    const V3 d = point_position(k, c.b) - point_position(k, c.a);
+    const M3 Rc = cut_rotation(k, c);
+    const Matrix Jw = frame_angular_jacobian(k, cut_frame(c));
+    Matrix Jc(3, n());
+    for (int j = 0; j < n(); ++j) Jc.col(j) = Rc.transpose() * (V3(Jd.col(j)) - V3(Jw.col(j)).cross(d));
     if (c.type == Cut::Type::Ball) {
-      for (int comp : c.components) J.row(row++) = Jd.row(comp);
+      for (int comp : c.components) J.row(row++) = Jc.row(comp);
     } else if (c.type == Cut::Type::Hinge) {
-      for (int comp = 0; comp < 3; ++comp) J.row(row++) = Jd.row(comp);
+      for (int comp = 0; comp < 3; ++comp) J.row(row++) = Jc.row(comp);
       // d/dq of (n . b) with n turning with a's body and b with b's: (omega_b - omega_a) . (b x n)
       // per unit joint rate, where the body's angular velocity gains the ground axis of every
       // revolute joint on its path to the ground.
@@ -300,8 +335,7 @@ NumericDynamics::Matrix NumericDynamics::constraint_jacobian(const Vector& q) co
       const Matrix Jw = angular_jacobian(k, c.b.body) - angular_jacobian(k, c.a.body);
       for (const V3& normal : axes.normals) J.row(row++) = axes.b.cross(normal).transpose() * Jw;
     } else {
-      const V3 d = point_position(k, c.b) - point_position(k, c.a);
-      J.row(row++) = (d / d.norm()).transpose() * Jd;
+      J.row(row++) = (d / value(c.length)).transpose() * Jd;
     }
   }
   return J;
@@ -313,10 +347,16 @@ NumericDynamics::Vector NumericDynamics::constraint_bias(const Vector& q, const 
   int row = 0;
   for (const Cut& c : model_.cuts) {
     const V3 acc = point_acceleration(k, c.b) - point_acceleration(k, c.a);
+    const V3 d = point_position(k, c.b) - point_position(k, c.a);
+    const V3 vel = point_velocity(k, c.b) - point_velocity(k, c.a);
+    // (Rc^T d)'' = Rc^T (d'' - alpha x d - 2 w x d' + w x (w x d)), w and alpha the cut frame's
+    const int frame = cut_frame(c);
+    const V3 w = frame < 0 ? V3::Zero() : k.omega[frame], al = frame < 0 ? V3::Zero() : k.alpha[frame];
+    const V3 accc = cut_rotation(k, c).transpose() * (acc - al.cross(d) - 2.0 * w.cross(vel) + w.cross(w.cross(d)));
     if (c.type == Cut::Type::Ball) {
-      for (int comp : c.components) b[row++] = acc[comp];
+      for (int comp : c.components) b[row++] = accc[comp];
     } else if (c.type == Cut::Type::Hinge) {
-      for (int comp = 0; comp < 3; ++comp) b[row++] = acc[comp];
+      for (int comp = 0; comp < 3; ++comp) b[row++] = accc[comp];
       // h = n . b with n' = w_a x n, b' = w_b x b: h'' = n'' . b + 2 n' . b' + n . b'', where
       // v'' = alpha x v + w x (w x v) and alpha holds only the velocity terms (qdd = 0)
       const HingeFrame axes = hinge_frame(k, c);
@@ -329,12 +369,8 @@ NumericDynamics::Vector NumericDynamics::constraint_bias(const Vector& q, const 
         b[row++] = n_acc.dot(axes.b) + 2.0 * n_rate.dot(b_rate) + normal.dot(b_acc);
       }
     } else {
-      // h = |d| - L: hddot = u . dddot + |ddot_perp|^2 / |d|
-      const V3 d = point_position(k, c.b) - point_position(k, c.a);
-      const V3 vel = point_velocity(k, c.b) - point_velocity(k, c.a);
-      const V3 u = d / d.norm();
-      const V3 perp = vel - u * u.dot(vel);
-      b[row++] = u.dot(acc) + perp.squaredNorm() / d.norm();
+      // h = (d.d - L^2) / 2L: hddot = (d'.d' + d.d'') / L
+      b[row++] = (vel.squaredNorm() + d.dot(acc)) / value(c.length);
     }
   }
   return b;
