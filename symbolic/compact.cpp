@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -257,6 +258,15 @@ class Compactor {
     return materialize(value, seeded && seeded_of(value), fresh_name());
   }
 
+  // -A when the negation of the sum r is the value of an auxiliary A already written.
+  NodeId negation_of_written(NodeId r) {
+    if (ctx_.op(r) != Op::Add) return kNone;
+    const NodeId negated = ctx_.make(Op::Neg, std::span<const NodeId>(&r, 1));
+    const auto it = materialized_.find(negated);
+    if (it == materialized_.end()) return kNone;
+    return ctx_.make(Op::Neg, std::span<const NodeId>(&it->second, 1));
+  }
+
   // n written: an atom, an auxiliary, or a small inline expression of written children.
   NodeId write_node(NodeId n) {
     if (ctx_.op(n) == Op::Symbol) {
@@ -271,6 +281,10 @@ class Compactor {
     for (NodeId k : kids) next.push_back(write_node(k));
     const bool seeded = seeded_of(n);
     NodeId r = build_small(n, std::move(next), seeded);
+    if (const NodeId negated = negation_of_written(r); negated != kNone) {
+      written_[n] = negated;  // -(a + b) of an a + b already written: the derivative of a rotation
+      return negated;
+    }
     if (readers_[n] > 1 && !is_atom(ctx_, r)) {
       if (stats_) ++stats_->shared;
       r = materialize(r, seeded, fresh_name());
@@ -299,6 +313,11 @@ class Compactor {
     }
     if (const auto it = materialized_.find(r); it != materialized_.end()) {
       alias_[a.target] = it->second;  // the same line was written for another node
+      if (stats_) ++stats_->merged;
+      return;
+    }
+    if (const NodeId negated = negation_of_written(r); negated != kNone) {
+      alias_[a.target] = negated;
       if (stats_) ++stats_->merged;
       return;
     }

@@ -83,7 +83,6 @@ class Generator {
     const std::vector<Expr> residual = dynamics(qdd, /*full=*/true, "");
     const std::vector<Expr> h = constraint_values();
     const std::vector<Expr> sensors = sensor_values();
-    out_.assignments_built = all_->size();
 
     const int n = m_.coordinates();
     const int mc = m_.constraint_count();
@@ -94,46 +93,67 @@ class Generator {
     };
     out_.inertial = std::make_unique<EquationList>(symbolic::eliminate(with_outputs(*all_, outputs("Mqdd", inertial))));
 
-    // Constraint derivatives: along time with qdd (accelerations), along time with qdd = 0
-    // (Jdot qd), along every q (J).
-    // the constraints' derivatives are taken on the compact scheme, so their size follows it
-    const EquationList h_list = symbolic::compact(symbolic::eliminate(with_outputs(*all_, outputs("h", h))));
-    Direction time_full{"t", "t", {}}, time_velocity{"v", "v", {}};
-    std::vector<Direction> along_q;
-    for (int j = 0; j < n; ++j) {
-      const Expr qj = ctx_->element(out_.q, j), qdj = ctx_->element(out_.qd, j);
-      time_full.seeds.push_back({qj.id(), qdj.id()});
-      time_full.seeds.push_back({qdj.id(), ctx_->element(out_.qdd, j).id()});
-      time_velocity.seeds.push_back({qj.id(), qdj.id()});
-      along_q.push_back(symbolic::along(qj));
+    // The constraint kinematics. J from the relative kinematics of the cut points (a joint turns
+    // a point by e x r: constraint_jacobian()), J qd from it; Jdot qd = d(J qd)/dt at qdd = 0,
+    // the recursive time derivative of that compact scheme (every auxiliary of the cut points'
+    // placements gets its rate); J qdd + Jdot qd (the residual's constraint accelerations) from
+    // the same list.
+    const std::vector<std::vector<Expr>> J = constraint_jacobian();
+    std::vector<Expr> jqd;
+    for (int i = 0; i < mc; ++i) {
+      std::vector<Expr> terms;
+      for (int j = 0; j < n; ++j)
+        if (!J[i][j].is_zero()) terms.push_back(J[i][j] * ctx_->element(out_.qd, j));
+      jqd.push_back(all_->assign("HD" + std::to_string(i + 1), ctx_->sum(terms)));
     }
-    const EquationList h_dot = symbolic::differentiate(h_list, std::span(&time_velocity, 1));
-    const EquationList h_ddot = symbolic::differentiate(symbolic::differentiate(h_list, std::span(&time_full, 1)),
-                                                        std::span(&time_full, 1));
-    const EquationList h_bias = symbolic::differentiate(h_dot, std::span(&time_velocity, 1));
-    const EquationList h_jac = symbolic::differentiate(h_list, along_q);
+    std::vector<Output> kinematic_outputs = outputs("h", h);
+    for (const Output& o : outputs("hdot", jqd)) kinematic_outputs.push_back(o);
+    for (int i = 0; i < mc; ++i)
+      for (int j = 0; j < n; ++j)
+        kinematic_outputs.push_back({"J[" + std::to_string(i) + "," + std::to_string(j) + "]", J[i][j].id()});
+    out_.assignments_built = all_->size();
+    // compacted before differentiation, so the derivative follows the compact scheme
+    const EquationList kinematic = symbolic::compact(symbolic::eliminate(with_outputs(*all_, kinematic_outputs)));
+    Direction time_velocity{"v", "v", {}};
+    for (int j = 0; j < n; ++j)
+      time_velocity.seeds.push_back({ctx_->element(out_.q, j).id(), ctx_->element(out_.qd, j).id()});
+    const EquationList bias = symbolic::differentiate(kinematic, std::span(&time_velocity, 1));
+    const std::size_t kinematic_outputs_count = kinematic.outputs().size();
+    auto h_out = [&](int i) { return kinematic.outputs()[i].value; };
+    auto jqd_out = [&](int i) { return kinematic.outputs()[mc + i].value; };
+    auto J_out = [&](int i, int j) { return kinematic.outputs()[2 * mc + i * n + j].value; };
+    auto bias_out = [&](int i) { return bias.outputs()[kinematic_outputs_count + mc + i].value; };
 
-    // residual: r then J qdd + Jdot qd (the last m outputs of the twice differentiated list)
     {
       std::vector<Output> o = outputs("r", residual);
-      for (int i = 0; i < mc; ++i) o.push_back({"a[" + std::to_string(i) + "]", h_ddot.outputs()[3 * mc + i].value});
-      out_.residual = merged(outputs("r", residual), {&h_list, &h_ddot}, std::move(o));
+      for (int i = 0; i < mc; ++i) {
+        std::vector<Expr> terms{ctx_->expr(bias_out(i))};
+        for (int j = 0; j < n; ++j) {
+          const Expr Jij = ctx_->expr(J_out(i, j));
+          if (!Jij.is_zero()) terms.push_back(Jij * ctx_->element(out_.qdd, j));
+        }
+        o.push_back({"a[" + std::to_string(i) + "]", ctx_->sum(terms).id()});
+      }
+      out_.residual = merged(outputs("r", residual), {&bias}, std::move(o));
     }
     {
-      std::vector<Output> o = outputs("h", h);
+      std::vector<Output> o;
+      for (int i = 0; i < mc; ++i) o.push_back({"h[" + std::to_string(i) + "]", h_out(i)});
       for (int i = 0; i < mc; ++i)
-        for (int j = 0; j < n; ++j)
-          o.push_back({"J[" + std::to_string(i) + "," + std::to_string(j) + "]", h_jac.outputs()[mc + j * mc + i].value});
-      for (int i = 0; i < mc; ++i) o.push_back({"Jdqd[" + std::to_string(i) + "]", h_bias.outputs()[3 * mc + i].value});
-      out_.constraints = merged({}, {&h_list, &h_jac, &h_dot, &h_bias}, std::move(o));
+        for (int j = 0; j < n; ++j) o.push_back({"J[" + std::to_string(i) + "," + std::to_string(j) + "]", J_out(i, j)});
+      for (int i = 0; i < mc; ++i) o.push_back({"Jdqd[" + std::to_string(i) + "]", bias_out(i)});
+      out_.constraints = merged({}, {&bias}, std::move(o));
     }
     {
-      std::vector<Output> o = outputs("h", h);
-      for (int i = 0; i < mc; ++i) o.push_back({"hdot[" + std::to_string(i) + "]", h_dot.outputs()[mc + i].value});
-      out_.velocity_constraints = merged({}, {&h_list, &h_dot}, std::move(o));
+      std::vector<Output> o;
+      for (int i = 0; i < mc; ++i) o.push_back({"h[" + std::to_string(i) + "]", h_out(i)});
+      for (int i = 0; i < mc; ++i) o.push_back({"hdot[" + std::to_string(i) + "]", jqd_out(i)});
+      out_.velocity_constraints = merged({}, {&kinematic}, std::move(o));
     }
     out_.sensors = std::make_unique<EquationList>(symbolic::eliminate(with_outputs(*all_, outputs("s", sensors))));
 
+    std::vector<Direction> along_q;
+    for (int j = 0; j < n; ++j) along_q.push_back(symbolic::along(ctx_->element(out_.q, j)));
     for (const JacobianRequest& request : m_.jacobians) {
       const V3 x = point_position(request.point);
       std::vector<Expr> xs{x[0], x[1], x[2]};
@@ -488,6 +508,88 @@ class Generator {
     return h;
   }
 
+  // Joints between a point's frame and the ancestor frame c (c excluded), from the point up.
+  std::vector<int> path_to(int frame, int c) const {
+    std::vector<int> path;
+    for (int k = frame; k != c && k >= 0; k = m_.joints[k].parent) path.push_back(k);
+    return path;
+  }
+  // d(P in c's components)/dq_j for joint j on P's path to c: e_j x (P - o_j) for a revolute
+  // joint (e_j its axis, o_j its origin, in c's components), e_j for a prismatic one.
+  V3 point_rate(PointRef p, int c, int j) {
+    const Joint& joint = m_.joints[j];
+    const Placement parent = relative_placement(joint.parent, c);
+    const V3 e = parent.rot.apply(joint_axis(j));
+    if (!is_revolute(joint.type)) return e;
+    return cross(e, point_in(p, c) - relative_placement(j, c).origin);
+  }
+  // dd/dq_j of a cut's vector d = b - a (cut frame components), by joint.
+  std::map<int, V3> cut_vector_rates(const Cut& c) {
+    const int frame = cut_frame(c);
+    std::map<int, V3> rates;
+    for (int j : path_to(m_.bodies[c.b.body].frame, frame)) rates[j] = point_rate(c.b, frame, j);
+    for (int j : path_to(m_.bodies[c.a.body].frame, frame)) {
+      const V3 r = point_rate(c.a, frame, j);
+      const auto it = rates.find(j);
+      rates[j] = it == rates.end() ? -r : it->second - r;
+    }
+    return rates;
+  }
+  // J (m x n): the cut equations' rates per joint, in closed form over the relative kinematics.
+  std::vector<std::vector<Expr>> constraint_jacobian() {
+    const int n = m_.coordinates();
+    std::vector<std::vector<Expr>> J;
+    int row = 0;
+    auto add_row = [&](const std::vector<Expr>& values) {
+      ++row;
+      std::vector<Expr> assigned(n);
+      for (int j = 0; j < n; ++j)
+        assigned[j] = all_->assign("JC" + std::to_string(row) + "_" + std::to_string(j + 1), values[j]);
+      J.push_back(assigned);
+    };
+    for (std::size_t ci = 0; ci < m_.cuts.size(); ++ci) {
+      const Cut& c = m_.cuts[ci];
+      std::map<int, V3> rates = cut_vector_rates(c);
+      for (auto& [j, rate] : rates) rate = assign("DCJ" + std::to_string(ci + 1) + "_", j, rate);
+      auto component_row = [&](int comp) {
+        std::vector<Expr> values(n, ctx_->zero());
+        for (const auto& [j, rate] : rates) values[j] = rate[comp];
+        add_row(values);
+      };
+      if (c.type == Cut::Type::Ball) {
+        for (int comp : c.components) component_row(comp);
+      } else if (c.type == Cut::Type::Hinge) {
+        for (int comp = 0; comp < 3; ++comp) component_row(comp);
+        // (n . b)' = (w_b - w_a) . (b x n): each revolute joint above b (a) turns it about its
+        // ground axis; joints above both cancel.
+        const HingeAxes axes = hinge_axes(c);
+        for (const V3& normal : axes.normals) {
+          const V3 bn = cross(axes.b, normal);
+          std::vector<Expr> values(n, ctx_->zero());
+          auto turn = [&](int frame, double sign) {
+            for (int j : path_to(frame, -1)) {
+              if (!is_revolute(m_.joints[j].type)) continue;
+              const int parent = m_.joints[j].parent;
+              const V3 e = frame_rotation(parent).apply(joint_axis(j));
+              values[j] = values[j] + sign * dot(e, bn);
+            }
+          };
+          turn(m_.bodies[c.b.body].frame, 1.0);
+          turn(m_.bodies[c.a.body].frame, -1.0);
+          add_row(values);
+        }
+      } else {
+        // h = (d.d - L^2) / 2L: dh/dq_j = d . dd/dq_j / L
+        const V3 d = cut_vector(ci);
+        const Expr inverse_length = 1.0 / val(c.length);
+        std::vector<Expr> values(n, ctx_->zero());
+        for (const auto& [j, rate] : rates) values[j] = dot(d, rate) * inverse_length;
+        add_row(values);
+      }
+    }
+    return J;
+  }
+
   // The nearest common ancestor of two joint frames (-1: the ground).
   int common_frame(int fa, int fb) const {
     std::vector<char> above(m_.coordinates(), 0);
@@ -509,6 +611,7 @@ class Generator {
     V3 origin;
   };
   Placement relative_placement(int k, int c) {
+    if (k < 0) return {Rot{{unit(0), unit(1), unit(2)}}, zero3()};  // the ground (then c < 0)
     if (c < 0) return {rot_[k], origin_[k]};
     if (k == c) return {Rot{{unit(0), unit(1), unit(2)}}, zero3()};
     const auto key = std::make_pair(k, c);
