@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <sys/wait.h>
 
@@ -72,6 +73,36 @@ TEST_F(DydpGen, ExpandWritesTheInExtensoForm) {
   const std::string cpp = read(dir / "out" / "chain3.cpp");
   EXPECT_EQ(cpp.find("const double OM"), std::string::npos) << "no auxiliaries in the in-extenso form";
   EXPECT_NE(cpp.find("out[1] = "), std::string::npos);
+}
+
+// The sedan's emitted code read as text: a recursive scheme prints every line small and never
+// assigns the same right-hand side twice within one function.
+TEST_F(DydpGen, SedanCodeHasSmallLinesAndNoRepeatedRightHandSides) {
+  const CommandResult r = run(std::string(DYDP_MODELS_DIR) + "/sedan.mbs.yaml --out \"" + (dir / "out").string() + "\"", dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::size_t files = 0, assignments = 0;
+  for (const auto& entry : fs::directory_iterator(dir / "out")) {
+    ++files;
+    std::istringstream text(read(entry.path()));
+    std::set<std::string> right_hand_sides;  // of the current function
+    std::string line;
+    int number = 0;
+    while (std::getline(text, line)) {
+      ++number;
+      EXPECT_LE(line.size(), 200u) << entry.path().filename() << ":" << number;
+      if (line.rfind("void ", 0) == 0) right_hand_sides.clear();
+      const std::size_t start = line.find("const double ");
+      const std::size_t equals = line.find(" = ");
+      if (start == std::string::npos || equals == std::string::npos || line.find('(', start) < equals ||
+          line.find('[', start) < equals)
+        continue;  // a signature or a descriptor's array
+      ++assignments;
+      EXPECT_TRUE(right_hand_sides.insert(line.substr(equals + 3)).second)
+          << entry.path().filename() << ":" << number << " repeats " << line.substr(equals + 3);
+    }
+  }
+  EXPECT_GE(files, 6u);
+  EXPECT_GT(assignments, 1000u);
 }
 
 TEST_F(DydpGen, BadInputExitsWithTwoAndFileLine) {
