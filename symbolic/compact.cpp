@@ -15,13 +15,25 @@
 #include <cmath>
 #include <span>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 namespace dydp::symbolic {
 namespace {
 
 constexpr NodeId kNone = 0xFFFFFFFFu;
+
+// A map from node ids to node ids (kNone when unset), dense: node ids are small integers.
+class NodeMap {
+ public:
+  NodeId get(NodeId n) const { return n < values_.size() ? values_[n] : kNone; }
+  void set(NodeId n, NodeId value) {
+    if (n >= values_.size()) values_.resize(std::max<std::size_t>(n + 1, 2 * values_.size()), kNone);
+    values_[n] = value;
+  }
+
+ private:
+  std::vector<NodeId> values_;
+};
 
 bool is_atom(const Context& ctx, NodeId n) {
   const Op op = ctx.op(n);
@@ -99,8 +111,7 @@ class Compactor {
     if (n < rebuilt_.size() && rebuilt_[n] != kNone) return rebuilt_[n];
     NodeId r = n;
     if (ctx_.op(n) == Op::Symbol) {
-      const auto it = substitute_.find(n);
-      if (it != substitute_.end()) r = it->second;
+      if (const NodeId to = substitute_.get(n); to != kNone) r = to;
     } else if (!is_atom(ctx_, n)) {
       const std::vector<NodeId> kids(ctx_.children(n).begin(), ctx_.children(n).end());
       std::vector<NodeId> next(kids.size());
@@ -118,21 +129,21 @@ class Compactor {
 
   void resolve() {
     rebuilt_.assign(ctx_.size(), kNone);
-    std::unordered_map<NodeId, NodeId> target_of_value;
+    NodeMap target_of_value;
     const std::size_t primal_end = in_.has_split() ? in_.primal_assignments() : in_.size();
     for (std::size_t i = 0; i < in_.size(); ++i) {
       const Assignment& a = in_.assignments()[i];
       const NodeId v = rebuild(a.value);
       if (is_trivial(ctx_, v)) {
-        substitute_[a.target] = v;
+        substitute_.set(a.target, v);
         continue;
       }
-      const auto [it, fresh] = target_of_value.try_emplace(v, a.target);
-      if (!fresh) {
-        substitute_[a.target] = it->second;
+      if (const NodeId earlier = target_of_value.get(v); earlier != kNone) {
+        substitute_.set(a.target, earlier);
         if (stats_) ++stats_->merged;
         continue;
       }
+      target_of_value.set(v, a.target);
       resolved_.push_back({a.target, v});
       resolved_primal_ += i < primal_end ? 1 : 0;
     }
@@ -176,7 +187,11 @@ class Compactor {
     if (seeded_known_.size() < ctx_.size()) seeded_known_.resize(ctx_.size(), -1);
     if (seeded_known_[n] >= 0) return seeded_known_[n];
     char s = 0;
-    for (NodeId c : std::vector<NodeId>(ctx_.children(n).begin(), ctx_.children(n).end())) s = s || seeded_of(c);
+    // seeded_of builds no nodes, so the children's span stays valid
+    for (NodeId c : ctx_.children(n)) {
+      s = seeded_of(c);
+      if (s) break;
+    }
     seeded_known_[n] = s;
     return s;
   }
@@ -185,9 +200,9 @@ class Compactor {
   // A new auxiliary holding `value` (built from written children), in the part it belongs to.
   NodeId materialize(NodeId value, bool seeded, const std::string& name) {
     // a value built twice (hash-consed: the same node) is one auxiliary
-    if (const auto it = materialized_.find(value); it != materialized_.end()) return it->second;
+    if (const NodeId existing = materialized_.get(value); existing != kNone) return existing;
     const Expr target = ctx_.aux(name);
-    materialized_[value] = target.id();
+    materialized_.set(value, target.id());
     if (seeded_.size() < ctx_.size()) seeded_.resize(ctx_.size(), 0);
     seeded_[target.id()] = seeded;
     (seeded && in_.has_split() ? derivative_ : primal_).push_back({target.id(), value});
@@ -200,7 +215,7 @@ class Compactor {
     if (n < line_ops_.size() && line_ops_[n] != kNone) return line_ops_[n];
     std::size_t c = own_line_ops(ctx_, n);
     if (!is_atom(ctx_, n))
-      for (NodeId k : std::vector<NodeId>(ctx_.children(n).begin(), ctx_.children(n).end())) c += line_ops(k);
+      for (NodeId k : ctx_.children(n)) c += line_ops(k);  // builds no nodes: the span stays valid
     if (n >= line_ops_.size()) line_ops_.resize(ctx_.size(), kNone);
     line_ops_[n] = static_cast<NodeId>(c);
     return c;
@@ -262,19 +277,19 @@ class Compactor {
   NodeId negation_of_written(NodeId r) {
     if (ctx_.op(r) != Op::Add) return kNone;
     const NodeId negated = ctx_.make(Op::Neg, std::span<const NodeId>(&r, 1));
-    const auto it = materialized_.find(negated);
-    if (it == materialized_.end()) return kNone;
-    return ctx_.make(Op::Neg, std::span<const NodeId>(&it->second, 1));
+    const NodeId target = materialized_.get(negated);
+    if (target == kNone) return kNone;
+    return ctx_.make(Op::Neg, std::span<const NodeId>(&target, 1));
   }
 
   // n written: an atom, an auxiliary, or a small inline expression of written children.
   NodeId write_node(NodeId n) {
     if (ctx_.op(n) == Op::Symbol) {
-      const auto it = alias_.find(n);
-      return it == alias_.end() ? n : it->second;
+      const NodeId to = alias_.get(n);
+      return to == kNone ? n : to;
     }
     if (is_atom(ctx_, n)) return n;
-    if (const auto it = written_.find(n); it != written_.end()) return it->second;
+    if (const NodeId done = written_.get(n); done != kNone) return done;
     const std::vector<NodeId> kids(ctx_.children(n).begin(), ctx_.children(n).end());
     std::vector<NodeId> next;
     next.reserve(kids.size());
@@ -282,14 +297,14 @@ class Compactor {
     const bool seeded = seeded_of(n);
     NodeId r = build_small(n, std::move(next), seeded);
     if (const NodeId negated = negation_of_written(r); negated != kNone) {
-      written_[n] = negated;  // -(a + b) of an a + b already written: the derivative of a rotation
+      written_.set(n, negated);  // -(a + b) of an a + b already written: the derivative of a rotation
       return negated;
     }
     if (readers_[n] > 1 && !is_atom(ctx_, r)) {
       if (stats_) ++stats_->shared;
       r = materialize(r, seeded, fresh_name());
     }
-    written_[n] = r;
+    written_.set(n, r);
     return r;
   }
 
@@ -297,8 +312,8 @@ class Compactor {
   void write_assignment(const Assignment& a) {
     current_name_ = ctx_.symbol(a.target).name;
     name_counter_ = 0;
-    if (const auto it = written_.find(a.value); it != written_.end() && !is_atom(ctx_, it->second)) {
-      alias_[a.target] = it->second;  // met before inside another right-hand side
+    if (const NodeId done = written_.get(a.value); done != kNone && !is_atom(ctx_, done)) {
+      alias_.set(a.target, done);  // met before inside another right-hand side
       if (stats_) ++stats_->merged;
       return;
     }
@@ -308,26 +323,26 @@ class Compactor {
     const bool seeded = seeded_of(a.value);
     const NodeId r = build_small(a.value, std::move(next), seeded);
     if (is_trivial(ctx_, r)) {  // cannot happen after resolve, but stay safe
-      alias_[a.target] = r;
+      alias_.set(a.target, r);
       return;
     }
-    if (const auto it = materialized_.find(r); it != materialized_.end()) {
-      alias_[a.target] = it->second;  // the same line was written for another node
+    if (const NodeId existing = materialized_.get(r); existing != kNone) {
+      alias_.set(a.target, existing);  // the same line was written for another node
       if (stats_) ++stats_->merged;
       return;
     }
     if (const NodeId negated = negation_of_written(r); negated != kNone) {
-      alias_[a.target] = negated;
+      alias_.set(a.target, negated);
       if (stats_) ++stats_->merged;
       return;
     }
-    materialized_[r] = a.target;
+    materialized_.set(r, a.target);
     if (seeded && in_.has_split()) derivative_.push_back({a.target, r});
     else {
       if (!seeded && in_.has_split() && assignment_index_ >= resolved_primal_ && stats_) ++stats_->hoisted;
       primal_.push_back({a.target, r});
     }
-    written_[a.value] = a.target;
+    written_.set(a.value, a.target);
   }
 
   void write() {
@@ -357,7 +372,7 @@ class Compactor {
   CompactStats* stats_;
 
   std::vector<NodeId> rebuilt_;
-  std::unordered_map<NodeId, NodeId> substitute_;
+  NodeMap substitute_;
   std::vector<Assignment> resolved_;
   std::size_t resolved_primal_ = 0;
   std::vector<NodeId> resolved_outputs_;
@@ -367,7 +382,7 @@ class Compactor {
   std::vector<signed char> seeded_known_;
   std::vector<NodeId> line_ops_;
 
-  std::unordered_map<NodeId, NodeId> written_, alias_, materialized_;
+  NodeMap written_, alias_, materialized_;
   std::vector<Assignment> primal_, derivative_;
   std::vector<Output> outputs_;
   std::string current_name_;

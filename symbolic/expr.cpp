@@ -228,7 +228,7 @@ Expr Context::aux(std::string_view name) {
 }
 
 bool Context::is_abbreviation(NodeId n) const {
-  return abbreviations_.count(n) != 0;
+  return n < abbreviation_flags_.size() && abbreviation_flags_[n];
 }
 
 const std::string& Context::abbreviation_name(NodeId n) const {

@@ -164,6 +164,7 @@ class Context {
   std::unordered_set<std::string> names_;
   std::unordered_map<std::string, std::size_t> next_suffix_;
   std::unordered_map<NodeId, std::string> abbreviations_;
+  std::vector<char> abbreviation_flags_;  // by node: is an abbreviation (the fast test)
   std::unordered_map<std::string, std::size_t> symbol_by_name_;
 };
 

@@ -274,6 +274,8 @@ NodeId Context::make_function(Op o, NodeId a) {
     const std::string wanted = arr.name == "q" ? letter + std::to_string(s.index + 1)
                                                : letter + "_" + s.name;
     abbreviations_.emplace(n, unique_name(wanted));
+    if (abbreviation_flags_.size() <= n) abbreviation_flags_.resize(n + 1, 0);
+    abbreviation_flags_[n] = 1;
   }
   return n;
 }
