@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libsundials-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev
-  gnuplot-nox
+  gnuplot-nox liborocos-kdl-dev
   qt6-base-dev qt6-charts-dev libqt6opengl6-dev libgl-dev
 )
 
