@@ -219,6 +219,16 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += number_array("double", "initial_q", q0);
   d += number_array("int", "driven", driven);
   d += number_array("int", "independent", independent);
+  std::vector<int> jacobian_nonzero;
+  {
+    const Context& ctx = lists.constraints->context();
+    const int m = model.constraint_count(), n = model.coordinates();
+    for (int k = 0; k < m * n; ++k) {
+      const NodeId v = lists.constraints->outputs()[m + k].value;
+      jacobian_nonzero.push_back(!(ctx.op(v) == Op::Constant && ctx.value(v) == 0.0));
+    }
+  }
+  d += number_array("int", "jacobian_nonzero", jacobian_nonzero);
   d += "}  // namespace\n\n";
   d += "// independent coordinates" + std::string(automatic ? " (automatic, pivoted QR of J at q0)" : "") + ":";
   for (const auto& u : result.independent) d += " " + u;
@@ -231,7 +241,8 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += "    " + std::to_string(driven.size()) + ", driven, " + std::to_string(independent.size()) + ", independent,\n";
   d += "    " + name + "_mass, " + name + "_residual, " + name + "_residual_tangent, " + name + "_constraints,\n";
   d += "    " + name + "_velocity_constraints_tangent, " + name + "_sensors, " + name + "_sensors_tangent,\n";
-  d += "    " + std::to_string(model.load_input_count()) + ", load_names, load_widths, sensor_units};\n\n";
+  d += "    " + std::to_string(model.load_input_count()) + ", load_names, load_widths, sensor_units,\n";
+  d += "    jacobian_nonzero};\n\n";
   d += "}  // namespace dydp::generated\n";
   write_atomically(options.out_dir / (name + "_model.cpp"), d);
   return result;

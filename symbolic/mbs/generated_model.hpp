@@ -55,6 +55,8 @@ struct GeneratedModel {
   const char* const* load_names;
   const int* load_widths;
   const char* const* sensor_units;  // SI unit of each sensor port ("m", "m/s", "rad", ...)
+  // m x n row-major: 0 where J is zero whatever the state (a joint that does not move the cut).
+  const int* jacobian_nonzero;
 };
 
 }  // namespace dydp::mbs

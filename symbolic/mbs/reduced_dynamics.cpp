@@ -20,6 +20,11 @@ ReducedDynamics::ReducedDynamics(const GeneratedModel& model) : model_(model), p
   if (static_cast<int>(v_.size()) != model.m)
     throw std::runtime_error(std::string(model.name) + ": dependent coordinates do not match the constraints");
   u_.assign(model.independent, model.independent + model.independent_count);
+  // Jv's structure: independent loops make it block diagonal (up to a permutation)
+  Eigen::Matrix<char, Eigen::Dynamic, Eigen::Dynamic> pattern(model.m, model.m);
+  for (int i = 0; i < model.m; ++i)
+    for (int k = 0; k < model.m; ++k) pattern(i, k) = model.jacobian_nonzero[i * model.n + v_[k]] != 0;
+  jv_blocks_.set_pattern(pattern);
 }
 
 namespace {
@@ -71,6 +76,7 @@ void ReducedDynamics::solve_kinematics(const double* u, const double* ud, const 
       evaluate_constraints();
       double norm = 0.0;
       for (int i = 0; i < m; ++i) norm = std::max(norm, std::abs(hj[i]));
+      if (r.Jv.size() != m) r.Jv = jv_blocks_;
       r.Jv.compute(columns(r.J, v_));
       if (norm < 1e-13) break;
       if (++r.newton_iterations > 30 || !std::isfinite(norm))
@@ -122,28 +128,31 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   // M [B beta] from the inertial pass seeded on those accelerations (nu + 1 directions; M
   // itself, n directions, is never formed): M qdd for qdd = B udd + beta is all we need.
   const int k = nu + (m > 0 ? 1 : 0);
-  Matrix seeds = Matrix::Zero(n, k);
+  // kept in r between calls: a large tree's n x n blocks would be fresh pages at every call
+  r.seeds.setZero(n, k);
   for (int a = 0; a < nf; ++a) {
-    seeds.row(f_[a]).head(nu) = r.B.row(a);
-    if (m > 0) seeds(f_[a], nu) = beta[a];
+    r.seeds.row(f_[a]).head(nu) = r.B.row(a);
+    if (m > 0) r.seeds(f_[a], nu) = beta[a];
   }
   std::vector<double> out(n);
   r.MB.resize(n, k);
-  model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, k, seeds.data(), out.data(), r.MB.data());
+  model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, k, r.seeds.data(), out.data(), r.MB.data());
 
-  Matrix MBf(nf, nu);  // M_ff B
+  // a tree (no constraints, u in coordinate order): B = I, M B = M, and the products would cost
+  // two dense n^3 products
+  const bool identity = m == 0 && u_ == f_;
+  const bool whole = identity && nf == n;  // no driven joints either: M_ff B is M
   Vector Mbeta = Vector::Zero(nf);
   Vector cf(nf);
+  if (!whole) r.MBf.resize(nf, nu);  // M_ff B
   for (int a = 0; a < nf; ++a) {
-    MBf.row(a) = r.MB.row(f_[a]).head(nu);
+    if (!whole) r.MBf.row(a) = r.MB.row(f_[a]).head(nu);
     if (m > 0) Mbeta[a] = r.MB(f_[a], nu);
     cf[a] = c[f_[a]];
   }
-  // a tree (no constraints, u in coordinate order): B = I, and the products would cost two
-  // dense n^3 products
-  const bool identity = m == 0 && u_ == f_;
-  if (identity) r.reduced.compute(MBf);
-  else r.reduced.compute(r.B.transpose() * MBf);
+  if (whole) r.reduced.compute(r.MB);
+  else if (identity) r.reduced.compute(r.MBf);
+  else r.reduced.compute(r.B.transpose() * r.MBf);
   if (r.reduced.info() != Eigen::Success)
     throw std::runtime_error(std::string(model_.name) + ": reduced mass matrix is not positive definite");
   r.udd = identity ? Vector(r.reduced.solve(-cf)) : Vector(r.reduced.solve(-(r.B.transpose() * (cf + Mbeta))));
@@ -156,7 +165,7 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
     const Vector full = c + r.MB.leftCols(nu) * r.udd + r.MB.col(nu);
     Vector fv(m);
     for (int i = 0; i < m; ++i) fv[i] = full[v_[i]];
-    r.lam = r.Jv.transpose().solve(fv);
+    r.lam = r.Jv.transpose_solve(fv);
   }
 }
 
@@ -238,13 +247,15 @@ void ReducedDynamics::tangent_dynamics(const Result& r, const double* inputs, co
       if (iv != v_.end()) dbeta.row(a) = dbeta_v.row(iv - v_.begin());
     }
   }
-  Matrix MBf(nf, nu);  // M_ff B; B^T M_ff dbeta = (M_ff B)^T dbeta, M being symmetric
-  for (int a = 0; a < nf; ++a) {
-    drf.row(a) = dout.row(f_[a]);
-    MBf.row(a) = r.MB.row(f_[a]).head(nu);
+  for (int a = 0; a < nf; ++a) drf.row(a) = dout.row(f_[a]);
+  // a tree in coordinate order: B = I (see solve_dynamics); otherwise B^T M_ff dbeta =
+  // (M_ff B)^T dbeta, M being symmetric, with M_ff B from solve_dynamics
+  if (m == 0 && u_ == f_) {
+    const Matrix dudd = r.reduced.solve(-drf);
+    for (int a = 0; a < nf; ++a) dqdd.row(f_[a]) = dudd.row(a);
+    return;
   }
-  const Matrix dudd = m == 0 && u_ == f_ ? Matrix(r.reduced.solve(-drf))
-                                          : Matrix(r.reduced.solve(-(r.B.transpose() * drf + MBf.transpose() * dbeta)));
+  const Matrix dudd = r.reduced.solve(-(r.B.transpose() * drf + r.MBf.transpose() * dbeta));
   const Matrix dqddf = r.B * dudd + dbeta;
   for (int a = 0; a < nf; ++a) dqdd.row(f_[a]) = dqddf.row(a);
 }

@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 #include <vector>
 
+#include "symbolic/mbs/block_lu.hpp"
 #include "symbolic/mbs/generated_model.hpp"
 
 namespace dydp::mbs {
@@ -27,9 +28,10 @@ class ReducedDynamics {
     Vector udd;
     Matrix MB;                                    // M [B beta]: n x (nu + 1 if m > 0)
     Matrix J;                                     // m x n
-    Eigen::PartialPivLU<Matrix> Jv;               // dependent columns of J
+    BlockLU Jv;                                   // dependent columns of J, loop by loop
     Matrix B;                                     // free coordinates x nu
     Eigen::LLT<Matrix> reduced;                   // B^T M_ff B
+    Matrix seeds, MBf;                            // work space: [B beta] over q, M_ff B
     int newton_iterations = 0;
   };
 
@@ -71,6 +73,7 @@ class ReducedDynamics {
   const GeneratedModel& model_;
   std::vector<int> u_, v_, f_, d_;
   std::vector<double> pad_;  // one zero for arrays of size zero
+  BlockLU jv_blocks_;        // Jv's block structure, copied into each Result
 };
 
 }  // namespace dydp::mbs
