@@ -1,7 +1,9 @@
 // A generic tangent checker for registered block types: made through the registry factory with
-// given settings and parameters, evaluated at random states and inputs, every tangent function
-// (outputs, derivatives, quadratures, initial state) is compared, entry by entry, with central
-// differences of the matching value function over a study of steps, keeping the best step.
+// given settings and parameters, evaluated at random states and inputs and at the defaults and
+// perturbed values of the parameters, every tangent function (outputs, derivatives, quadratures,
+// initial state, and an objective block's psi) is compared, entry by entry, with central
+// differences of the matching value function over a study of steps relative to each variable's
+// size, keeping the best step; a value that is not finite at any step fails the check.
 // Outputs are evaluated as the engine does: state-only outputs first with the inputs not ready
 // (inputs poisoned with NaN, so reading them shows), then all outputs with the inputs ready.
 #pragma once
@@ -18,6 +20,7 @@
 #include <vector>
 
 #include "engine/block.hpp"
+#include "engine/objective.hpp"
 #include "engine/registry.hpp"
 
 namespace dydp::test {
@@ -39,6 +42,22 @@ struct BlockCase {
   int samples = 6;
   double tolerance = 1e-6;
   unsigned seed = 12345;
+  /// Parameter values checked: the case's (`params` over the defaults), then parameter_sets - 1
+  /// draws with every differentiable parameter scaled by 1 +- parameter_spread (a zero one
+  /// moved by +- parameter_spread), reflected into the parameter's bounds.
+  int parameter_sets = 3;
+  double parameter_spread = 0.1;
+  /// Finite-difference steps, relative to each variable's scale: a state's or input's spread,
+  /// a parameter's magnitude (zero_parameter_scale for a parameter that is zero).
+  std::vector<double> steps = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7};
+  double zero_parameter_scale = 1e-3;
+  /// At most this many directions are finite-differenced (0: all): large blocks check a spread
+  /// of their states, inputs and parameters that keeps the first and last of each kind.
+  int direction_limit = 0;
+  /// Objective blocks: the quadratures' values at the end of the run (default 1 +- 0.5 each),
+  /// and the number of output samples of the first input over [0, 1] s.
+  std::vector<Range> quadrature_values;
+  int objective_samples = 9;
 };
 
 /// The block of a case, made through the registry.
@@ -245,109 +264,256 @@ inline std::vector<double> local_jacobian(const engine::Block& b, const Point& p
   return jac;
 }
 
+/// Parameter sets of a case: its own values, then perturbed draws (see BlockCase).
+inline std::vector<std::vector<double>> parameter_sets(const BlockCase& c, const engine::BlockType& type,
+                                                       const std::vector<double>& p0) {
+  std::vector<std::vector<double>> sets = {p0};
+  std::mt19937_64 rng(c.seed + 7919);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int k = 1; k < c.parameter_sets; ++k) {
+    std::vector<double> p = p0;
+    for (size_t j = 0; j < p.size(); ++j) {
+      const engine::ParamSpec& spec = type.parameters[j];
+      const double r = unit(rng);
+      if (!spec.differentiable) continue;
+      double v = p0[j] != 0.0 ? p0[j] * (1 + c.parameter_spread * r) : c.parameter_spread * r;
+      if (v < spec.lower) v = 2 * spec.lower - v;
+      if (v > spec.upper) v = 2 * spec.upper - v;
+      if (v >= spec.lower && v <= spec.upper) p[j] = v;
+    }
+    sets.push_back(p);
+  }
+  return sets;
+}
+
+/// The directions finite-differenced: all, or a spread keeping each group's first and last.
+inline std::vector<int> checked_directions(int nd, const std::vector<int>& group_starts, int limit) {
+  std::vector<int> picked;
+  const int stride = limit > 0 && nd > limit ? nd / limit + 1 : 1;
+  for (int v = 0; v < nd; ++v) {
+    bool edge = v == nd - 1;
+    for (int start : group_starts) edge = edge || v == start || v == start - 1;
+    if (edge || v % stride == 0) picked.push_back(v);
+  }
+  return picked;
+}
+
+/// Evaluates, turning a block's OutOfDomain into a test failure (false) that names the point.
+inline bool try_evaluate(const engine::Block& b, const Point& pt, Values& out, const std::string& where) {
+  try {
+    out = evaluate(b, pt);
+    return true;
+  } catch (const engine::OutOfDomain& e) {
+    ADD_FAILURE() << where << ": out of domain (" << e.reason << "); the case's ranges leave the block's domain";
+    return false;
+  }
+}
+
+/// An objective block's psi and dpsi for every quadrature and every sample of its first input.
+inline void check_objective(const BlockCase& c, const engine::Block& b, const engine::Objective& objective,
+                            const std::vector<double>& p, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const int nq = b.num_quadratures();
+  const int width = b.inputs().empty() ? 0 : b.inputs()[0].width;
+  const int ns = c.objective_samples;
+  std::vector<double> q, t, u, scale;
+  std::vector<std::string> names;
+  for (int i = 0; i < nq; ++i) {
+    const Range r = i < static_cast<int>(c.quadrature_values.size()) ? c.quadrature_values[i] : Range{1.0, 0.5};
+    q.push_back(r.center + r.spread * unit(rng));
+    scale.push_back(r.spread);
+    names.push_back("quadrature " + std::to_string(i));
+  }
+  const Range ur = !c.inputs.empty() && !c.inputs[0].empty() ? c.inputs[0][0] : Range{};
+  for (int k = 0; k < ns; ++k) {
+    t.push_back(ns > 1 ? static_cast<double>(k) / (ns - 1) : 0.0);
+    for (int i = 0; i < width; ++i) {
+      u.push_back(ur.center + ur.spread * unit(rng));
+      scale.push_back(ur.spread);
+      names.push_back("sample " + std::to_string(k) + " of the input, element " + std::to_string(i));
+    }
+  }
+  const int nd = static_cast<int>(scale.size());
+  const auto psi = [&](const std::vector<double>& qq, const std::vector<double>& uu, int directions,
+                       const std::vector<double>& dq, const std::vector<double>& du, std::vector<double>& dpsi) {
+    engine::ObjectiveSamples s;
+    s.t_start = 0.0;
+    s.t_stop = 1.0;
+    s.directions = directions;
+    s.width = width;
+    s.t = &t;
+    s.u = &uu;
+    s.du = &du;
+    dpsi.assign(std::max(directions, 1), std::numeric_limits<double>::quiet_NaN());
+    return objective.objective(p.data(), qq.data(), {dq.empty() ? nullptr : dq.data(), nq}, s, dpsi.data());
+  };
+  // Seeds: direction d < nq on quadrature d, the others on one input sample each.
+  std::vector<double> dq(static_cast<size_t>(nq) * nd, 0.0), du(static_cast<size_t>(ns) * nd * width, 0.0);
+  for (int d = 0; d < nq; ++d) dq[static_cast<size_t>(d) * nq + d] = 1.0;
+  for (int k = 0; k < ns; ++k)
+    for (int i = 0; i < width; ++i) {
+      const int d = nq + k * width + i;
+      du[(static_cast<size_t>(k) * nd + d) * width + i] = 1.0;
+    }
+  std::vector<double> dpsi, unused;
+  const double psi0 = psi(q, u, nd, dq, du, dpsi);
+  EXPECT_TRUE(std::isfinite(psi0)) << c.type << ": psi";
+  double row_size = 0;
+  for (int d = 0; d < nd; ++d) row_size = std::max(row_size, std::fabs(dpsi[d]) * scale[d]);
+  for (int d = 0; d < nd; ++d) {
+    double best = std::numeric_limits<double>::infinity(), best_fd = 0;
+    for (double rel : c.steps) {
+      const double h = rel * scale[d];
+      std::vector<double> qp = q, qm = q, up = u, um = u;
+      if (d < nq) qp[d] += h, qm[d] -= h;
+      else up[d - nq] += h, um[d - nq] -= h;
+      const double fd = (psi(qp, up, 0, {}, {}, unused) - psi(qm, um, 0, {}, {}, unused)) / (2 * h);
+      EXPECT_TRUE(std::isfinite(fd)) << c.type << ": psi not finite by " << names[d] << " at step " << h;
+      if (std::fabs(fd - dpsi[d]) < best) best = std::fabs(fd - dpsi[d]), best_fd = fd;
+    }
+    const double allowed = c.tolerance * (std::fabs(dpsi[d]) + 1e-3 * row_size / scale[d]) + 1e-300;
+    EXPECT_LE(best, allowed) << c.type << ": objective psi by " << names[d] << ": tangent " << dpsi[d]
+                             << ", finite difference " << best_fd;
+    EXPECT_TRUE(std::isfinite(dpsi[d])) << c.type << ": dpsi by " << names[d];
+  }
+}
+
 }  // namespace detail
 
-/// Runs the check for every sample and time; failures name the function, row and variable.
+/// Runs the check for every parameter set, sample and time; failures name the function, row,
+/// variable and parameter set.
 inline void check_tangents(const BlockCase& c) {
-  std::vector<double> p0;
-  const auto block = make_block(c, &p0);
+  std::vector<double> p_case;
+  const auto block = make_block(c, &p_case);
   const engine::Block& b = *block;
   const engine::BlockType* type = engine::Registry::global().find(c.type);
-  const int nx = b.num_states(), np = static_cast<int>(p0.size());
+  const int nx = b.num_states(), np = static_cast<int>(p_case.size());
   std::mt19937_64 rng(c.seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
 
-  // Variable names and scales, in direction order.
+  // Variable names, in direction order, and where states, inputs and parameters start.
   std::vector<std::string> names;
   for (int i = 0; i < nx; ++i) names.push_back("state " + b.state_names()[i]);
+  const int first_input = static_cast<int>(names.size());
   for (const auto& port : b.inputs())
     for (int i = 0; i < port.width; ++i) names.push_back("input " + port.name + "[" + std::to_string(i) + "]");
+  const int first_parameter = static_cast<int>(names.size());
   for (const auto& spec : type->parameters) names.push_back("parameter " + spec.name);
   const int nd = static_cast<int>(names.size());
+  const std::vector<int> checked = detail::checked_directions(nd, {first_input, first_parameter}, c.direction_limit);
+  const auto* objective = dynamic_cast<const engine::Objective*>(&b);
 
-  for (int sample = 0; sample < c.samples; ++sample)
-    for (double t : c.times) {
-      detail::Point pt;
-      pt.t = t;
-      pt.p = p0;
-      std::vector<double> scale;
-      for (int i = 0; i < nx; ++i) {
-        const Range r = i < static_cast<int>(c.states.size()) ? c.states[i] : Range{};
-        pt.x.push_back(r.center + r.spread * unit(rng));
-        scale.push_back(r.spread);
-      }
-      for (size_t k = 0; k < b.inputs().size(); ++k) {
-        pt.u.emplace_back();
-        for (int i = 0; i < b.inputs()[k].width; ++i) {
-          const Range r = k < c.inputs.size() && i < static_cast<int>(c.inputs[k].size()) ? c.inputs[k][i] : Range{};
-          pt.u.back().push_back(r.center + r.spread * unit(rng));
+  const std::vector<std::vector<double>> sets = detail::parameter_sets(c, *type, p_case);
+  for (size_t set = 0; set < sets.size(); ++set) {
+    const std::vector<double>& p0 = sets[set];
+    std::string at_set = "parameter set " + std::to_string(set);
+    if (set > 0) {
+      at_set += " (";
+      for (int j = 0; j < np; ++j) at_set += (j ? ", " : "") + type->parameters[j].name + " = " + std::to_string(p0[j]);
+      at_set += ")";
+    }
+    SCOPED_TRACE(c.type + ", " + at_set);
+    if (objective) detail::check_objective(c, b, *objective, p0, rng);
+    for (int sample = 0; sample < c.samples; ++sample)
+      for (double t : c.times) {
+        detail::Point pt;
+        pt.t = t;
+        pt.p = p0;
+        std::vector<double> scale;
+        for (int i = 0; i < nx; ++i) {
+          const Range r = i < static_cast<int>(c.states.size()) ? c.states[i] : Range{};
+          pt.x.push_back(r.center + r.spread * unit(rng));
           scale.push_back(r.spread);
         }
-      }
-      for (int j = 0; j < np; ++j) scale.push_back(std::max(std::fabs(p0[j]), 1e-3));
+        for (size_t k = 0; k < b.inputs().size(); ++k) {
+          pt.u.emplace_back();
+          for (int i = 0; i < b.inputs()[k].width; ++i) {
+            const Range r = k < c.inputs.size() && i < static_cast<int>(c.inputs[k].size()) ? c.inputs[k][i] : Range{};
+            pt.u.back().push_back(r.center + r.spread * unit(rng));
+            scale.push_back(r.spread);
+          }
+        }
+        for (int j = 0; j < np; ++j) scale.push_back(p0[j] != 0.0 ? std::fabs(p0[j]) : c.zero_parameter_scale);
 
-      const detail::Values base = detail::evaluate(b, pt);
-      const detail::Values an = detail::tangents(b, pt, nd);
-      // A local Jacobian, where the block provides one, is the state columns of the derivative
-      // tangents (checked against finite differences below).
-      const std::vector<double> local = detail::local_jacobian(b, pt);
-      for (size_t k = 0; k < local.size(); ++k) {
-        const double expected = an.xdot[k];  // column k / nx is state direction k / nx
-        EXPECT_NEAR(local[k], expected, 1e-12 * (std::fabs(expected) + 1e-300))
-            << c.type << ": local_jacobian row " << k % nx << " by " << names[k / nx];
-      }
-      // Perturbs variable v of a copy of the point by h.
-      const auto perturbed = [&](int v, double h) {
-        detail::Point q = pt;
-        if (v < nx) { q.x[v] += h; return q; }
-        int k = v - nx;
-        for (auto& port : q.u) {
-          if (k < static_cast<int>(port.size())) { port[k] += h; return q; }
-          k -= static_cast<int>(port.size());
+        detail::Values base;
+        if (!detail::try_evaluate(b, pt, base, c.type + " at t = " + std::to_string(t))) continue;
+        const detail::Values an = detail::tangents(b, pt, nd);
+        // A local Jacobian, where the block provides one, is the state columns of the derivative
+        // tangents (checked against finite differences below).
+        const std::vector<double> local = detail::local_jacobian(b, pt);
+        for (size_t k = 0; k < local.size(); ++k) {
+          const double expected = an.xdot[k];  // column k / nx is state direction k / nx
+          EXPECT_NEAR(local[k], expected, 1e-12 * (std::fabs(expected) + 1e-300))
+              << c.type << ": local_jacobian row " << k % nx << " by " << names[k / nx];
         }
-        q.p[k] += h;
-        return q;
-      };
-      struct Fn { const char* name; std::vector<double> detail::Values::*member; };
-      const Fn fns[] = {{"outputs", &detail::Values::y}, {"derivatives", &detail::Values::xdot},
-                        {"quadratures", &detail::Values::qdot}, {"initial_state", &detail::Values::x0}};
-      for (int v = 0; v < nd; ++v) {
-        const bool input_or_state = v < static_cast<int>(scale.size()) - np;
-        // Switching times and other non-differentiable parameters: the engine refuses them as
-        // sensitivity directions, so their tangents are not part of the contract.
-        if (!input_or_state && !type->parameters[v - (nd - np)].differentiable) continue;
-        std::vector<detail::Values> plus, minus;
-        std::vector<double> steps;
-        for (double rel : {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7}) {
-          const double h = rel * scale[v];
-          steps.push_back(h);
-          plus.push_back(detail::evaluate(b, perturbed(v, h)));
-          minus.push_back(detail::evaluate(b, perturbed(v, -h)));
-        }
+        // Perturbs variable v of a copy of the point by h.
+        const auto perturbed = [&](int v, double h) {
+          detail::Point q = pt;
+          if (v < nx) { q.x[v] += h; return q; }
+          int k = v - nx;
+          for (auto& port : q.u) {
+            if (k < static_cast<int>(port.size())) { port[k] += h; return q; }
+            k -= static_cast<int>(port.size());
+          }
+          q.p[k] += h;
+          return q;
+        };
+        struct Fn { const char* name; std::vector<double> detail::Values::*member; };
+        const Fn fns[] = {{"outputs", &detail::Values::y}, {"derivatives", &detail::Values::xdot},
+                          {"quadratures", &detail::Values::qdot}, {"initial_state", &detail::Values::x0}};
         for (const Fn& fn : fns) {
           const std::vector<double>& f0 = base.*fn.member;
-          const int rows = static_cast<int>(f0.size());
-          for (int r = 0; r < rows; ++r) {
-            if (fn.member == &detail::Values::x0 && input_or_state) continue;
-            const double analytic = (an.*fn.member)[static_cast<size_t>(v) * rows + r];
-            // The row's natural size: its largest tangent times that variable's scale.
-            double row_size = 0;
-            for (int w = 0; w < nd; ++w)
-              row_size = std::max(row_size, std::fabs((an.*fn.member)[static_cast<size_t>(w) * rows + r]) * scale[w]);
-            double best = std::numeric_limits<double>::infinity(), best_fd = 0;
-            for (size_t k = 0; k < steps.size(); ++k) {
-              const double fd = ((plus[k].*fn.member)[r] - (minus[k].*fn.member)[r]) / (2 * steps[k]);
-              if (std::fabs(fd - analytic) < best) best = std::fabs(fd - analytic), best_fd = fd;
+          for (size_t r = 0; r < f0.size(); ++r)
+            EXPECT_TRUE(std::isfinite(f0[r])) << c.type << ": " << fn.name << " row " << r << " at t = " << t;
+        }
+        for (int v : checked) {
+          const bool input_or_state = v < first_parameter;
+          // Switching times and other non-differentiable parameters: the engine refuses them as
+          // sensitivity directions, so their tangents are not part of the contract.
+          if (!input_or_state && !type->parameters[v - first_parameter].differentiable) continue;
+          std::vector<detail::Values> plus, minus;
+          std::vector<double> steps;
+          bool evaluated = true;
+          for (double rel : c.steps) {
+            const double h = rel * scale[v];
+            steps.push_back(h);
+            plus.emplace_back();
+            minus.emplace_back();
+            const std::string where = c.type + " at t = " + std::to_string(t) + ", " + names[v] + " moved by ";
+            evaluated = detail::try_evaluate(b, perturbed(v, h), plus.back(), where + std::to_string(h)) &&
+                        detail::try_evaluate(b, perturbed(v, -h), minus.back(), where + std::to_string(-h));
+            if (!evaluated) break;
+          }
+          if (!evaluated) continue;
+          for (const Fn& fn : fns) {
+            const std::vector<double>& f0 = base.*fn.member;
+            const int rows = static_cast<int>(f0.size());
+            for (int r = 0; r < rows; ++r) {
+              if (fn.member == &detail::Values::x0 && input_or_state) continue;
+              const double analytic = (an.*fn.member)[static_cast<size_t>(v) * rows + r];
+              // The row's natural size: its largest tangent times that variable's scale.
+              double row_size = 0;
+              for (int w = 0; w < nd; ++w)
+                row_size = std::max(row_size, std::fabs((an.*fn.member)[static_cast<size_t>(w) * rows + r]) * scale[w]);
+              double best = std::numeric_limits<double>::infinity(), best_fd = 0;
+              for (size_t k = 0; k < steps.size(); ++k) {
+                const double fd = ((plus[k].*fn.member)[r] - (minus[k].*fn.member)[r]) / (2 * steps[k]);
+                // A step that leaves the block's domain gives NaN: a failure, not a dropped step
+                // (steps are relative to each variable's size, so they should not leave it).
+                EXPECT_TRUE(std::isfinite(fd)) << c.type << ": " << fn.name << " row " << r << " by " << names[v]
+                                               << " at t = " << t << ": not finite at step " << steps[k];
+                if (std::fabs(fd - analytic) < best) best = std::fabs(fd - analytic), best_fd = fd;
+              }
+              const double allowed = c.tolerance * (std::fabs(analytic) + 1e-3 * row_size / scale[v]) + 1e-300;
+              EXPECT_LE(best, allowed) << c.type << ": " << fn.name << " row " << r << " by " << names[v]
+                                       << " at t = " << t << ": tangent " << analytic << ", finite difference "
+                                       << best_fd;
+              EXPECT_TRUE(std::isfinite(analytic)) << fn.name << " row " << r << " by " << names[v];
             }
-            const double allowed = c.tolerance * (std::fabs(analytic) + 1e-3 * row_size / scale[v]) + 1e-300;
-            EXPECT_LE(best, allowed) << c.type << ": " << fn.name << " row " << r << " by " << names[v]
-                                     << " at t = " << t << ": tangent " << analytic << ", finite difference "
-                                     << best_fd;
-            EXPECT_TRUE(std::isfinite(analytic)) << fn.name << " row " << r << " by " << names[v];
           }
         }
       }
-    }
+  }
 }
 
 }  // namespace dydp::test
