@@ -377,43 +377,50 @@ class Generator {
       ext_f[p.body] = ext_f[p.body] + f;
       ext_n[p.body] = ext_n[p.body] + cross(anchor(p), f);
     };
+    // A force given in the components of joint frame `frame`, at a point: turned into the
+    // point's body frame by the relative rotation when `frame` is an ancestor (for a spring
+    // between chassis and wishbone, one joint's rotation) instead of through the ground.
+    auto apply_in = [&](PointRef p, int frame, const V3& force) {
+      if (p.body == 0) return;
+      const V3 f = to_body(p.body, frame, force);
+      ext_f[p.body] = ext_f[p.body] + f;
+      ext_n[p.body] = ext_n[p.body] + cross(anchor(p), f);
+    };
     std::vector<Expr> joint_force(n, ctx_->zero());
     if (full) {
       int at = 0;
       for (const Load& l : m_.loads) {
         if (l.type == Load::Type::LinkForce) {
-          const V3 d = point_position(l.b) - point_position(l.point);
+          // in the frame of the two bodies' common ancestor: lengths do not depend on it
+          const int c = common_frame(m_.bodies[l.point.body].frame, m_.bodies[l.b.body].frame);
+          const V3 d = assign("DL", at, point_in(l.b, c) - point_in(l.point, c));
           const Expr length = all_->assign("LL" + std::to_string(at + 1), symbolic::sqrt(dot(d, d)));
           const Expr magnitude = ctx_->element(out_.inp, at++);
           const V3 f = ((l.compression ? magnitude : -magnitude) / length) * d;  // on b
-          apply(l.b, f);
-          apply(l.point, -f);
+          apply_in(l.b, c, f);
+          apply_in(l.point, c, -f);
           continue;
         }
         V3 given = zero3();
         for (int c : l.components) given[c] = ctx_->element(out_.inp, at++);
-        const V3 ground = body_rotation(l.frame).apply(given);
+        const int frame = m_.bodies[l.frame].frame;
         if (l.type == Load::Type::Force) {
-          apply(l.point, ground);
+          apply_in(l.point, frame, given);
         } else {
-          if (l.point.body != 0)
-            ext_n[l.point.body] = ext_n[l.point.body] + body_rotation(l.point.body).apply_transpose(ground);
-          if (l.reaction > 0)
-            ext_n[l.reaction] = ext_n[l.reaction] - body_rotation(l.reaction).apply_transpose(ground);
+          if (l.point.body != 0) ext_n[l.point.body] = ext_n[l.point.body] + to_body(l.point.body, frame, given);
+          if (l.reaction > 0) ext_n[l.reaction] = ext_n[l.reaction] - to_body(l.reaction, frame, given);
         }
       }
       int row = 0;
       for (std::size_t ci = 0; ci < m_.cuts.size(); ++ci) {
         const Cut& c = m_.cuts[ci];
-        // ball and hinge rows are components in the cut's frame; its force in ground components
-        const Rot frame = frame_rotation(cut_frame(c));
+        // ball and hinge rows are components in the cut's frame, and so is their force
+        const int frame = cut_frame(c);
         V3 f = zero3();
         if (c.type == Cut::Type::Ball) {
           for (int comp : c.components) f[comp] = ctx_->element(out_.lam, row++);
-          f = frame.apply(f);
         } else if (c.type == Cut::Type::Hinge) {
           for (int comp = 0; comp < 3; ++comp) f[comp] = ctx_->element(out_.lam, row++);
-          f = frame.apply(f);
           // The alignment rows h = (R_a n) . (R_b axis_b) vary by (dtheta_b - dtheta_a) . (b x n):
           // their multipliers are the torques lam (b x n) on b and the opposite on a.
           const HingeAxes axes = hinge_axes(c);
@@ -424,10 +431,10 @@ class Generator {
           if (c.a.body != 0) ext_n[c.a.body] = ext_n[c.a.body] - body_rotation(c.a.body).apply_transpose(torque);
         } else {
           // h = (d.d - L^2) / 2L: J^T lam is the force (lam / L) d on b
-          f = frame.apply((ctx_->element(out_.lam, row++) / val(c.length)) * cut_vector(ci));
+          f = (ctx_->element(out_.lam, row++) / val(c.length)) * cut_vector(ci);
         }
-        apply(c.b, f);
-        apply(c.a, -f);
+        apply_in(c.b, frame, f);
+        apply_in(c.a, frame, -f);
       }
       int spring = 0;
       for (const ForceElement& e : m_.forces) {
@@ -588,6 +595,16 @@ class Generator {
       }
     }
     return J;
+  }
+
+  // v, given in the components of joint frame `frame` (-1: the ground), in body's frame.
+  V3 to_body(int body, int frame, const V3& v) {
+    const int fb = m_.bodies[body].frame;
+    if (fb == frame) return v;
+    bool ancestor = frame < 0;
+    for (int k = fb; k >= 0 && !ancestor; k = m_.joints[k].parent) ancestor = k == frame;
+    if (ancestor) return relative_placement(fb, frame).rot.apply_transpose(v);
+    return body_rotation(body).apply_transpose(frame_rotation(frame).apply(v));
   }
 
   // The nearest common ancestor of two joint frames (-1: the ground).
