@@ -196,10 +196,11 @@ Node read_block(const SceneReader& r, const YAML::Node& key, const YAML::Node& b
       settings.set(k, std::move(v));
     }
   }
-  for (const auto& [name, value] : forced)
+  // Not a structured binding: clang 14 (the fuzz build) cannot capture one in the lambda.
+  for (const auto& setting : forced)
     if (std::any_of(type.settings.begin(), type.settings.end(),
-                    [&](const SettingSpec& s) { return s.name == name; }))
-      settings.set(name, {{value}, false, node.line});
+                    [&](const SettingSpec& s) { return s.name == setting.first; }))
+      settings.set(setting.first, {{setting.second}, false, node.line});
   for (const SettingSpec& s : type.settings) {
     if (settings.has(s.name)) continue;
     if (s.required) r.fail(key, node.name + "." + s.name, "required setting is missing");
