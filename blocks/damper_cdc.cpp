@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <sstream>
 
 #include "blocks/hydraulics.hpp"
 #include "engine/registry.hpp"
@@ -281,7 +282,17 @@ const engine::BlockRegistration damper_cdc({
      {"friction", "N", 30.0, false, 0.0, kInf, "seal friction (Coulomb level)"},
      {"friction_velocity", "m/s", 0.01, false, 1e-6, kInf, "stroke rate at which friction reaches 76 % of its level"}},
     {},
-    [](const engine::BlockSettings&) -> std::unique_ptr<Block> { return std::make_unique<DamperCdc>(); }});
+    [](const engine::BlockSettings&) -> std::unique_ptr<Block> { return std::make_unique<DamperCdc>(); },
+    // The annulus A_piston - A_rod carries the rebound pressure: a rod as wide as the piston
+    // leaves none, a wider one a negative area and forces of the wrong size and sign.
+    {{"rod_diameter < piston_diameter", "rod_diameter", engine::BlockCheck::Severity::error,
+      [](const engine::CheckInput& in) -> std::optional<std::string> {
+        if (in.p[kRodDiameter] < in.p[kPistonDiameter]) return std::nullopt;
+        std::ostringstream why;
+        why << "rod " << in.p[kRodDiameter] << " m is not narrower than the piston "
+            << in.p[kPistonDiameter] << " m (piston_diameter)";
+        return why.str();
+      }}}});
 
 }  // namespace
 }  // namespace dydp::blocks

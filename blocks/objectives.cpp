@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "blocks/objective_window.hpp"
 #include "engine/objective.hpp"
 #include "engine/registry.hpp"
 
@@ -141,19 +142,21 @@ std::unique_ptr<Block> make_integral(const BlockSettings& s) {
 
 const engine::BlockRegistration integral({"objective.integral", "objectives",
     "psi = integral of the input over the window.", {}, {kWindowSpec},
-    make_integral<Integral::Kind::integral>});
+    make_integral<Integral::Kind::integral>, window_checks()});
 const engine::BlockRegistration mean({"objective.mean", "objectives",
     "psi = mean of the input over the window.", {}, {kWindowSpec},
-    make_integral<Integral::Kind::mean>});
+    make_integral<Integral::Kind::mean>, window_checks()});
 const engine::BlockRegistration rms({"objective.rms", "objectives",
     "psi = root mean square of the input over the window.", {}, {kWindowSpec},
-    make_integral<Integral::Kind::rms>});
+    make_integral<Integral::Kind::rms>, window_checks()});
 const engine::BlockRegistration max_abs({"objective.max_abs", "objectives",
     "psi = largest |input| at the output samples in the window.", {}, {kWindowSpec},
-    [](const BlockSettings& s) -> std::unique_ptr<Block> { return std::make_unique<MaxAbs>(read_window(s)); }});
+    [](const BlockSettings& s) -> std::unique_ptr<Block> { return std::make_unique<MaxAbs>(read_window(s)); },
+    window_checks()});
 const engine::BlockRegistration final_value({"objective.final", "objectives",
     "psi = the input at the last output sample in the window.", {}, {kWindowSpec},
-    [](const BlockSettings& s) -> std::unique_ptr<Block> { return std::make_unique<FinalValue>(read_window(s)); }});
+    [](const BlockSettings& s) -> std::unique_ptr<Block> { return std::make_unique<FinalValue>(read_window(s)); },
+    window_checks()});
 
 }  // namespace
 }  // namespace dydp::blocks

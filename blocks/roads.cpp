@@ -5,6 +5,7 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <sstream>
 #include <string>
 
 #include "blocks/time_series.hpp"
@@ -55,6 +56,7 @@ class FourPoster : public Block {
     declare_output("z", 4, "m");
     declare_output("zdot", 4, "m/s");
   }
+  const std::vector<TimeSeries>& recorded() const { return recorded_; }
   static int amplitude(int pad) { return 3 * pad; }
   static int frequency(int pad) { return 3 * pad + 1; }
   static int phase(int pad) { return 3 * pad + 2; }
@@ -150,7 +152,21 @@ const engine::BlockRegistration fourposter({
       }
       return std::make_unique<FourPoster>(static_cast<unsigned long long>(s.integer("seed")),
                                           positive_integer(s, "components"), std::move(recorded));
-    }});
+    },
+    {{"noise_low <= noise_high", "noise_low", engine::BlockCheck::Severity::error,
+      [](const engine::CheckInput& in) -> std::optional<std::string> {
+        if (in.p[FourPoster::kNoiseLow] <= in.p[FourPoster::kNoiseHigh]) return std::nullopt;
+        std::ostringstream why;
+        why << "noise band [" << in.p[FourPoster::kNoiseLow] << ", " << in.p[FourPoster::kNoiseHigh]
+            << "] Hz: its low end is above its high end (noise_high)";
+        return why.str();
+      }},
+     {"input_file covers [time.start, time.stop]", "input_file", engine::BlockCheck::Severity::warning,
+      [](const engine::CheckInput& in) -> std::optional<std::string> {
+        const auto* rig = dynamic_cast<const FourPoster*>(in.block);
+        if (!rig || rig->recorded().empty()) return std::nullopt;
+        return uncovered_span(rig->recorded().front(), in.t_start, in.t_stop);
+      }}}});
 
 // ---------------------------------------------------------------- road.iso8608
 

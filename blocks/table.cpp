@@ -17,6 +17,7 @@ class Table : public Block {
       : series_(read_time_series(s, "file", s.text("time_column"), {s.text("column")}, "column").front()) {
     declare_output("y", 1);
   }
+  const TimeSeries& series() const { return series_; }
   void outputs(const Eval& e, double* const* y) const override { y[0][0] = series_.linear(e.t); }
   void outputs_tangent(const Eval&, const Seeds& s, const DirView* dy) const override {
     for (int d = 0; d < s.directions; ++d) dy[0](0, d) = 0.0;
@@ -32,7 +33,12 @@ const engine::BlockRegistration table({
     {{"file", "CSV file, relative to the scene", "", true},
      {"column", "column to output", "", true},
      {"time_column", "column holding time [s]", "t", false}},
-    [](const engine::BlockSettings& s) -> std::unique_ptr<Block> { return std::make_unique<Table>(s); }});
+    [](const engine::BlockSettings& s) -> std::unique_ptr<Block> { return std::make_unique<Table>(s); },
+    {{"file covers [time.start, time.stop]", "file", engine::BlockCheck::Severity::warning,
+      [](const engine::CheckInput& in) -> std::optional<std::string> {
+        const auto* table = dynamic_cast<const Table*>(in.block);
+        return table ? uncovered_span(table->series(), in.t_start, in.t_stop) : std::nullopt;
+      }}}});
 
 }  // namespace
 }  // namespace dydp::blocks

@@ -1,6 +1,7 @@
 #include "blocks/time_series.hpp"
 
 #include <algorithm>
+#include <sstream>
 
 #include "engine/csv.hpp"
 #include "engine/errors.hpp"
@@ -38,6 +39,23 @@ void TimeSeries::cubic(double t, double& y, double& ydot) const {
   const double s2 = s * s, s3 = s2 * s;
   y = (2 * s3 - 3 * s2 + 1) * y_[k - 1] + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * y_[k] + (s3 - s2) * m1;
   ydot = ((6 * s2 - 6 * s) * y_[k - 1] + (3 * s2 - 4 * s + 1) * m0 + (-6 * s2 + 6 * s) * y_[k] + (3 * s2 - 2 * s) * m1) / h;
+}
+
+std::optional<std::string> uncovered_span(const TimeSeries& series, double t_start, double t_stop) {
+  if (series.times().empty()) return std::nullopt;
+  const double first = series.times().front(), last = series.times().back();
+  const auto number = [](double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  };
+  if (last < t_stop)
+    return "the recording ends at " + number(last) + " s, before time.stop = " + number(t_stop) +
+           " s: its last value is held";
+  if (first > t_start)
+    return "the recording starts at " + number(first) + " s, after time.start = " + number(t_start) +
+           " s: its first value is held";
+  return std::nullopt;
 }
 
 std::vector<TimeSeries> read_time_series(const engine::BlockSettings& s, const std::string& file_key,

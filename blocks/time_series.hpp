@@ -3,6 +3,7 @@
 // segments (value and slope continuous: a recorded displacement and its rate).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,10 @@ class TimeSeries {
   double slope(size_t k) const;
   std::vector<double> t_, y_;
 };
+
+/// Why a recording does not cover the run [t_start, t_stop] (it starts late or ends early, and
+/// its end value is held), or nothing when it covers it: a warning rule of recorded inputs.
+std::optional<std::string> uncovered_span(const TimeSeries& series, double t_start, double t_stop);
 
 /// Reads the columns `columns` against `time_column` from the CSV file in setting `file_key`;
 /// errors name the setting (missing column) or the file and row (bad data, times not

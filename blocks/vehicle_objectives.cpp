@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "blocks/objective_window.hpp"
 #include "engine/objective.hpp"
 #include "engine/registry.hpp"
 
@@ -71,7 +72,8 @@ const engine::BlockRegistration slip_angle({
         from = v[0], to = v[1];
       }
       return std::make_unique<SlipAngle>(from, to);
-    }});
+    },
+    window_checks()});
 
 }  // namespace
 }  // namespace dydp::blocks

@@ -18,6 +18,11 @@ bool parse_number(const std::string& text, double& value) {
   return end == begin + text.size() && errno == 0 && std::isfinite(value);
 }
 
+int BlockSettings::line(const std::string& name) const {
+  const auto it = values_.find(name);
+  return it == values_.end() || it->second.line <= 0 ? line_ : it->second.line;
+}
+
 const BlockSettings::Value& BlockSettings::get(const std::string& name) const {
   auto it = values_.find(name);
   if (it == values_.end())

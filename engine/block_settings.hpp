@@ -40,6 +40,8 @@ class BlockSettings {
 
   /// Throws InputError at the setting's line ("file:line: block.name: message").
   [[noreturn]] void fail(const std::string& name, const std::string& message) const;
+  /// Line where the setting was written (the block's line for a default or an unknown name).
+  int line(const std::string& name) const;
 
   const std::string& block_name() const { return block_; }
   const std::string& file() const { return file_; }

@@ -1,5 +1,6 @@
 #include "engine/csv.hpp"
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -29,6 +30,8 @@ int CsvFile::find(const std::string& name) const {
 }
 
 CsvFile read_csv(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path, 0, "", "is a folder, not a CSV file");
   std::ifstream in(path);
   if (!in) throw InputError(path, 0, "", "cannot open the CSV file");
   CsvFile csv;

@@ -50,6 +50,9 @@ struct Node {
   int line = 0;
   std::unique_ptr<Block> block;
   const Objective* objective = nullptr;  ///< the block as an objective, or null
+  /// The settings it was made from (its consistency checks read them again when a scene
+  /// parameter changes); null for nodes not read from a scene.
+  std::shared_ptr<const BlockSettings> settings;
 
   std::vector<double> p;            ///< parameter values, ParamSpec order
   std::vector<int> p_scene;         ///< scene parameter driving p[j], or -1
@@ -88,6 +91,9 @@ class Diagram {
   /// the same inputs (state-only outputs first).
   std::vector<OutputStep> output_steps;
   std::vector<std::string> pruned;     ///< blocks no requested output needs
+  /// Legal but probably unintended input found at load time ("file:line: field: message"):
+  /// printed by the commands and recorded in run.json `warnings`.
+  std::vector<std::string> warnings;
   std::vector<LoggedSignal> logged;    ///< one entry per scalar logged
   std::vector<int> objectives;         ///< node indices of requested objectives
   int num_states = 0;

@@ -8,6 +8,13 @@
 
 namespace dydp::engine {
 
+/// A number in a message as a rule states it: 1e-12, 0.5, 1e+06, inf (six significant digits).
+inline std::string format_number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
 /// Bad input: a scene, a CSV table, a command-line value. what() reads "file:line: field: message".
 class InputError : public std::runtime_error {
  public:

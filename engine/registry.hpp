@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "engine/block.hpp"
+#include "engine/block_check.hpp"
 #include "engine/block_settings.hpp"
 
 namespace dydp::engine {
@@ -36,6 +37,9 @@ struct BlockType {
   std::vector<ParamSpec> parameters;
   std::vector<SettingSpec> settings;
   std::function<std::unique_ptr<Block>(const BlockSettings&)> make;
+  /// Relations its values must satisfy, checked at load time and whenever a scene parameter
+  /// driving one of them changes (engine/consistency_checks.hpp).
+  std::vector<BlockCheck> checks = {};
 };
 
 class Registry {

@@ -19,9 +19,12 @@ int RunResult::signal_index(const std::string& name) const {
 }
 
 RunResult run(const Diagram& d, const RunOptions& options) {
-  if (d.solver.method == "rk4") return run_rk4(d, options);
-  if (d.solver.method == "sdirk2") return run_sdirk(d, options);
-  return run_cvodes(d, options);
+  RunResult r = d.solver.method == "rk4"      ? run_rk4(d, options)
+                : d.solver.method == "sdirk2" ? run_sdirk(d, options)
+                                              : run_cvodes(d, options);
+  // The load-time warnings first: what the input says, then what the run found.
+  r.stats.warnings.insert(r.stats.warnings.begin(), d.warnings.begin(), d.warnings.end());
+  return r;
 }
 
 }  // namespace dydp::engine

@@ -4,16 +4,30 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
 #include <set>
 
+#include "engine/consistency_checks.hpp"
 #include "engine/diagram.hpp"
+#include "engine/duplicate_keys.hpp"
 #include "engine/errors.hpp"
 #include "engine/graph_builder.hpp"
+#include "engine/scene_relations.hpp"
 
 namespace dydp::engine {
 namespace {
 
 int line_of(const YAML::Node& n) { return n.Mark().is_null() ? 0 : n.Mark().line + 1; }
+
+/// A number, not zero as written, so small that it is denormal or zero as a double (1e-320).
+bool underflows(const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  return end == text.c_str() + text.size() && std::fabs(v) < std::numeric_limits<double>::min() &&
+         text.find_first_of("123456789") < text.find_first_of("eE");
+}
 
 class SceneReader {
  public:
@@ -30,7 +44,12 @@ class SceneReader {
   double number(const YAML::Node& n, const std::string& field) const {
     if (!n.IsScalar()) fail(n, field, "expected a number");
     double v = 0;
-    if (!parse_number(n.Scalar(), v)) fail(n, field, "malformed number '" + n.Scalar() + "'");
+    if (!parse_number(n.Scalar(), v)) {
+      if (underflows(n.Scalar()))
+        fail(n, field, "value " + n.Scalar() + " underflows (denormal or zero as a double, below " +
+                           format_number(std::numeric_limits<double>::min()) + ")");
+      fail(n, field, "malformed number '" + n.Scalar() + "'");
+    }
     return v;
   }
 
@@ -66,10 +85,11 @@ void read_time(const SceneReader& r, const YAML::Node& n, TimeSpec& time) {
     r.fail(n["stop"] ? n["stop"] : n, "time.stop", "must be greater than time.start");
   if (!(time.output_step > 0))
     r.fail(n["output_step"] ? n["output_step"] : n, "time.output_step", "must be positive");
+  check_time_relations(r.file(), n, time);
 }
 
-void read_solver(const SceneReader& r, const YAML::Node& n, SolverSpec& s) {
-  if (!n) return;
+void read_solver(const SceneReader& r, const YAML::Node& n, const TimeSpec& time, SolverSpec& s) {
+  if (!n) return check_solver_relations(r.file(), n, s, time);
   r.allow_keys(n, "solver", {"method", "rtol", "atol", "step", "max_steps", "min_step", "sens_error_test"});
   if (n["method"]) {
     s.method = r.text(n["method"], "solver.method");
@@ -84,12 +104,19 @@ void read_solver(const SceneReader& r, const YAML::Node& n, SolverSpec& s) {
     if (v != "true" && v != "false") r.fail(e, "solver.sens_error_test", "expected true or false");
     s.sens_error_test = v == "true";
   }
-  if (n["max_steps"]) s.max_steps = static_cast<long>(r.number(n["max_steps"], "solver.max_steps"));
+  if (n["max_steps"]) {
+    const double v = r.number(n["max_steps"], "solver.max_steps");
+    if (!(v >= 1 && v <= kMaxStepLimit && v == std::floor(v)))
+      r.fail(n["max_steps"], "solver.max_steps",
+             "value " + n["max_steps"].Scalar() + " must be a whole number in [1, " + format_number(kMaxStepLimit) + "]");
+    s.max_steps = static_cast<long>(v);
+  }
   if (n["min_step"]) s.min_step = r.number(n["min_step"], "solver.min_step");
   if (!(s.min_step >= 0)) r.fail(n["min_step"], "solver.min_step", "must not be negative");
   if (!(s.rtol > 0)) r.fail(n["rtol"], "solver.rtol", "must be positive");
   if (!(s.atol > 0)) r.fail(n["atol"], "solver.atol", "must be positive");
   if (s.step < 0) r.fail(n["step"], "solver.step", "must be positive");
+  check_solver_relations(r.file(), n, s, time);
 }
 
 void read_parameters(const SceneReader& r, const YAML::Node& n, Diagram& d) {
@@ -119,14 +146,15 @@ void read_parameters(const SceneReader& r, const YAML::Node& n, Diagram& d) {
     }
     if (d.find_parameter(p.name) >= 0) r.fail(kv.first, field, "defined twice");
     if (p.value < p.lower || p.value > p.upper)
-      r.fail(kv.first, field, "value " + std::to_string(p.value) + " outside its range");
+      r.fail(kv.first, field, "value " + format_number(p.value) + " outside its range");
     d.parameters.push_back(p);
   }
 }
 
 /// One block of the scene: parameters resolved, settings collected, instance made.
 Node read_block(const SceneReader& r, const YAML::Node& key, const YAML::Node& body,
-                const Diagram& d, const std::vector<std::pair<std::string, std::string>>& forced) {
+                const Diagram& d, const std::vector<std::pair<std::string, std::string>>& forced,
+                std::vector<std::string>& warnings) {
   Node node;
   node.name = key.Scalar();
   node.line = line_of(key);
@@ -168,10 +196,11 @@ Node read_block(const SceneReader& r, const YAML::Node& key, const YAML::Node& b
       settings.set(k, std::move(v));
     }
   }
-  for (const auto& [name, value] : forced)
+  // Not a structured binding: clang 14 (the fuzz build) cannot capture one in the lambda.
+  for (const auto& setting : forced)
     if (std::any_of(type.settings.begin(), type.settings.end(),
-                    [&](const SettingSpec& s) { return s.name == name; }))
-      settings.set(name, {{value}, false, node.line});
+                    [&](const SettingSpec& s) { return s.name == setting.first; }))
+      settings.set(setting.first, {{setting.second}, false, node.line});
   for (const SettingSpec& s : type.settings) {
     if (settings.has(s.name)) continue;
     if (s.required) r.fail(key, node.name + "." + s.name, "required setting is missing");
@@ -199,14 +228,16 @@ Node read_block(const SceneReader& r, const YAML::Node& key, const YAML::Node& b
     }
     if (value < s.lower || value > s.upper)
       r.fail(v ? line : node.line, field,
-             "value " + std::to_string(value) + " outside [" + std::to_string(s.lower) + ", " +
-                 std::to_string(s.upper) + "]" + (s.unit.empty() ? "" : " " + s.unit));
+             "value " + format_number(value) + " outside [" + format_number(s.lower) + ", " +
+                 format_number(s.upper) + "]" + (s.unit.empty() ? "" : " " + s.unit));
     node.p.push_back(value);
     node.p_scene.push_back(scene);
     node.p_line.push_back(line);
   }
   node.block = type.make(settings);
   node.objective = dynamic_cast<const Objective*>(node.block.get());
+  node.settings = std::make_shared<const BlockSettings>(std::move(settings));
+  check_block(r.file(), node, node.p, d.time, &warnings);
   return node;
 }
 
@@ -216,6 +247,9 @@ Diagram load_scene(const std::string& path,
                    const std::vector<std::pair<std::string, std::string>>& overrides,
                    const std::vector<std::pair<std::string, std::string>>& setting_overrides) {
   SceneReader r(path);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(path, 0, "", "is a folder, not a scene file");
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
@@ -225,6 +259,7 @@ Diagram load_scene(const std::string& path,
     throw InputError(path, e.mark.line + 1, "", "YAML syntax: " + e.msg);
   }
   if (!root.IsMap()) throw InputError(path, 1, "", "a scene is a YAML mapping");
+  refuse_duplicate_keys(root, path);
   r.allow_keys(root, "", {"scene", "description", "time", "solver", "parameters",
                                "sensitivities", "blocks", "connections", "outputs", "layout"});
 
@@ -232,7 +267,7 @@ Diagram load_scene(const std::string& path,
   d.file = path;
   d.scene_name = root["scene"] ? r.text(root["scene"], "scene") : "scene";
   read_time(r, root["time"], d.time);
-  read_solver(r, root["solver"], d.solver);
+  read_solver(r, root["solver"], d.time, d.solver);
   read_parameters(r, root["parameters"], d);
 
   for (const auto& [name, text] : overrides) {
@@ -265,7 +300,7 @@ Diagram load_scene(const std::string& path,
   GraphBuilder graph(path);
   for (auto kv : blocks) {
     if (graph.has_block(kv.first.Scalar())) r.fail(kv.first, kv.first.Scalar(), "block defined twice");
-    graph.add_block(read_block(r, kv.first, kv.second, d, setting_overrides));
+    graph.add_block(read_block(r, kv.first, kv.second, d, setting_overrides, d.warnings));
   }
 
   // Sensitivity directions must only reach parameters the blocks can differentiate.
@@ -322,7 +357,7 @@ void Diagram::set_parameter(int index, double value, bool check_range) {
   SceneParameter& sp = parameters.at(index);
   if (check_range && (value < sp.lower || value > sp.upper))
     throw InputError(file, sp.line, "parameters." + sp.name,
-                     "value " + std::to_string(value) + " outside its range");
+                     "value " + format_number(value) + " outside its range");
   // Check every block parameter it drives before changing any: a refused value leaves none behind.
   for (const Node& n : nodes)
     for (size_t j = 0; j < n.p.size(); ++j)
@@ -330,9 +365,16 @@ void Diagram::set_parameter(int index, double value, bool check_range) {
         const ParamSpec& s = n.type->parameters[j];
         if (value < s.lower || value > s.upper)
           throw InputError(file, n.p_line[j], n.name + "." + s.name,
-                           "value " + std::to_string(value) + " (from $" + sp.name +
+                           "value " + format_number(value) + " (from $" + sp.name +
                                ") outside its bounds");
       }
+  for (const Node& n : nodes) {
+    std::vector<double> p = n.p;
+    bool driven = false;
+    for (size_t j = 0; j < p.size(); ++j)
+      if (n.p_scene[j] == index) p[j] = value, driven = true;
+    if (driven) check_block(file, n, p, time, nullptr);
+  }
   for (Node& n : nodes)
     for (size_t j = 0; j < n.p.size(); ++j)
       if (n.p_scene[j] == index) n.p[j] = value;

@@ -35,7 +35,7 @@ SweepResult sweep(const SweepSpec& spec) {
   const SceneParameter& sp = probe.parameters[index];
   for (double p : {spec.low, spec.high})
     if (p < sp.lower || p > sp.upper)
-      throw InputError("--range", 0, spec.parameter, "value " + std::to_string(p) + " outside the parameter's range");
+      throw InputError("--range", 0, spec.parameter, "value " + format_number(p) + " outside the parameter's range");
 
   SweepResult result;
   result.parameter = spec.parameter;

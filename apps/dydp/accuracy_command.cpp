@@ -8,6 +8,7 @@
 #include "apps/dydp/commands.hpp"
 #include "apps/dydp/gnuplot.hpp"
 #include "engine/accuracy.hpp"
+#include "engine/errors.hpp"
 #include "engine/output_writer.hpp"
 
 namespace dydp::apps {
@@ -32,7 +33,12 @@ std::string accuracy_csv(const engine::AccuracyReport& r) {
 }  // namespace
 
 int accuracy_command(const AccuracyArgs& args) {
+  // A relative accuracy: above 0 (none is reached exactly), below 1 (100 % says nothing).
+  if (!(args.target > 0 && args.target < 1))
+    throw engine::InputError("--target", 0, engine::format_number(args.target),
+                             "outside (0, 1): a relative accuracy");
   engine::Diagram d = engine::load_scene(args.scene, parse_sets(args.sets));
+  print_warnings(d.warnings);
   engine::AccuracySpec spec;
   spec.methods = args.methods;
   std::cerr << "accuracy: reference run (bdf, rtol " << spec.reference_rtol << ") and its check...\n";

@@ -2,6 +2,7 @@
 #include <iomanip>
 
 #include "apps/dydp/commands.hpp"
+#include "engine/consistency_checks.hpp"
 #include "engine/registry.hpp"
 
 namespace dydp::apps {
@@ -20,6 +21,7 @@ int blocks_command(std::ostream& out) {
       out << "    setting " << std::left << std::setw(12) << s.name
           << (s.required ? " required" : " default '" + s.default_value + "'") << "  "
           << s.description << "\n";
+    for (const std::string& rule : engine::check_rules(*t)) out << "    check   " << rule << "\n";
     // Ports of an instance with default settings (types that need settings say so).
     engine::BlockSettings defaults(t->name, "", 0);
     bool complete = true;

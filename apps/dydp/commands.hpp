@@ -49,6 +49,9 @@ int accuracy_command(const AccuracyArgs& args);
 int sweep_command(const SweepArgs& args);
 int blocks_command(std::ostream& out);
 
+/// Prints the scene's load-time warnings to stderr ("warning: file:line: field: message").
+void print_warnings(const std::vector<std::string>& warnings);
+
 /// Splits NAME=VALUE pairs; throws InputError naming --set on a malformed one.
 std::vector<std::pair<std::string, std::string>> parse_sets(const std::vector<std::string>& sets);
 

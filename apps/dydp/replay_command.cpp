@@ -81,6 +81,7 @@ int replay_command(const ReplayArgs& args) {
     throw engine::InputError(args.scene, 0, "blocks",
                              "no block of this scene takes recorded input (a block with an `input_file` "
                              "setting, such as road.fourposter)");
+  print_warnings(d.warnings);
 
   std::filesystem::create_directories(args.out);
   StreamingCsv stream(args.out + "/signals.csv");

@@ -24,8 +24,13 @@ std::vector<std::pair<std::string, std::string>> parse_sets(const std::vector<st
   return out;
 }
 
+void print_warnings(const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
+}
+
 int run_command(const RunArgs& args) {
   engine::Diagram d = engine::load_scene(args.scene, parse_sets(args.sets));
+  print_warnings(d.warnings);
 
   engine::RunOptions options;
   options.sensitivities = !args.no_sens;

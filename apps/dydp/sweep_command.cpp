@@ -14,6 +14,8 @@
 namespace dydp::apps {
 namespace {
 
+constexpr int kMaxSweepPoints = 1000000;
+
 /// "LO:HI:N" -> low, high, points.
 void parse_range(const std::string& text, engine::SweepSpec& spec) {
   std::stringstream ss(text);
@@ -23,6 +25,11 @@ void parse_range(const std::string& text, engine::SweepSpec& spec) {
       !engine::parse_number(lo, spec.low) || !engine::parse_number(hi, spec.high) ||
       !engine::parse_number(n, points) || points < 1 || points != std::floor(points) || spec.high < spec.low)
     throw engine::InputError("--range", 0, text, "expected LO:HI:N with LO <= HI and N >= 1");
+  // One point spans no range: LO:HI:1 with LO < HI would sweep nothing but LO.
+  if (points > kMaxSweepPoints)
+    throw engine::InputError("--range", 0, text, "N = " + n + " is more than " + std::to_string(kMaxSweepPoints) + " runs");
+  if (points == 1 && spec.low < spec.high)
+    throw engine::InputError("--range", 0, text, "N = 1 with LO < HI sweeps one point: give N >= 2, or LO = HI");
   spec.points = static_cast<int>(points);
 }
 
@@ -60,7 +67,9 @@ int sweep_command(const SweepArgs& args) {
   parse_range(args.range, spec);
   spec.fd_steps = args.fd_steps;
   for (double h : spec.fd_steps)
-    if (!(h > 0)) throw engine::InputError("--fd", 0, std::to_string(h), "steps must be positive");
+    if (!(h > 0 && std::isfinite(h))) throw engine::InputError("--fd", 0, engine::format_number(h), "steps must be positive");
+  if (!(args.delta >= 0 && std::isfinite(args.delta)))
+    throw engine::InputError("--delta", 0, engine::format_number(args.delta), "must be positive (0: no change column)");
   spec.keep_runs = args.report;
   std::cerr << "sweep: " << spec.points << " runs of " << args.scene << " over " << spec.parameter
             << " in [" << spec.low << ", " << spec.high << "]"

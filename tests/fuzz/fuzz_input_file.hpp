@@ -1,0 +1,32 @@
+// A fuzz input as a file: the readers under test take paths. One file per process, rewritten
+// for every input, removed at exit.
+#pragma once
+
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace dydp::fuzz {
+
+class InputFile {
+ public:
+  explicit InputFile(const std::string& extension)
+      : path_((std::filesystem::temp_directory_path() /
+               ("dydp_fuzz_" + std::to_string(::getpid()) + extension)).string()) {}
+  ~InputFile() { std::remove(path_.c_str()); }
+
+  const std::string& write(const uint8_t* data, size_t size) {
+    std::ofstream(path_, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(data),
+                                                                     static_cast<std::streamsize>(size));
+    return path_;
+  }
+
+ private:
+  std::string path_;
+};
+
+}  // namespace dydp::fuzz
