@@ -12,6 +12,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <ostream>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
@@ -56,6 +57,8 @@ const StressCase kCases[] = {
     {"pothole_lift_off", true, {}},
     {"tiny_chambers", false, {0.0, 0.01, "damper", "stroke beyond the chambers' length"}},
 };
+
+void PrintTo(const StressCase& c, std::ostream* os) { *os << c.scene; }
 
 fs::path stress_scene(const std::string& name) { return source_path("scenarios/stress/" + name + ".yaml"); }
 
