@@ -1,15 +1,22 @@
-// Running the built dydp program from a test: its exit status, stdout and stderr, and the
-// entries of an output folder (to assert that refused input writes nothing).
+// Running the built dydp program from a test: a process runner capturing stdout, stderr and
+// the exit status, the entries of an output folder (refused input writes nothing), and a fixture
+// with a temporary folder that runs `dydp ARGS` and reads the CSV and JSON files a run writes.
 #pragma once
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "engine/csv.hpp"
+#include "tests/temp_folder_test.hpp"
 
 namespace dydp::test {
 
@@ -25,7 +32,7 @@ inline std::string read_text(const std::filesystem::path& p) {
   return s.str();
 }
 
-/// `s` as one shell word.
+/// `s` quoted for the shell.
 inline std::string quote(const std::string& s) {
   std::string q = "'";
   for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
@@ -52,5 +59,42 @@ inline std::vector<std::string> entries(const std::filesystem::path& dir) {
   for (const auto& e : std::filesystem::directory_iterator(dir)) names.push_back(e.path().filename().string());
   return names;
 }
+
+inline std::filesystem::path source_path(const std::string& relative) {
+  return std::filesystem::path(DYDP_SOURCE_DIR) / relative;
+}
+
+/// A column of a CSV file the program wrote, by name; throws when it is missing.
+inline const std::vector<double>& column(const engine::CsvFile& csv, const std::string& name) {
+  const int c = csv.find(name);
+  if (c < 0) throw std::runtime_error(csv.path + ": no column " + name);
+  return csv.columns[static_cast<size_t>(c)];
+}
+
+class DydpProcessTest : public TempFolderTest {
+ protected:
+  explicit DydpProcessTest(std::string prefix) : TempFolderTest(std::move(prefix)) {}
+
+  /// Runs `dydp ARGS` (ARGS already quoted).
+  ProcessResult dydp(const std::string& args) const {
+    const std::filesystem::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = quote(DYDP_EXE) + " " + args + " >" + quote(out.string()) + " 2>" +
+                            quote(err.string());
+    const int raw = std::system(cmd.c_str());
+    ProcessResult r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = read_text(out);
+    r.err = read_text(err);
+    return r;
+  }
+
+  /// The text of a shipped file with `from` replaced by `to` (which must occur once).
+  static std::string replaced(std::string text, const std::string& from, const std::string& to) {
+    const size_t at = text.find(from);
+    if (at == std::string::npos || text.find(from, at + 1) != std::string::npos)
+      throw std::runtime_error("expected exactly one '" + from + "'");
+    return text.replace(at, from.size(), to);
+  }
+};
 
 }  // namespace dydp::test
