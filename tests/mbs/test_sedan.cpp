@@ -281,7 +281,7 @@ TEST(Sedan, RideFrequencies) {
     const double f = std::sqrt(lambda) / (2 * std::numbers::pi);
     hz.push_back(f);
     // A wheel-hop mode (above 8 Hz) belongs to the axle whose arms (u 6, 7 front; 8, 9 rear) move.
-    const auto v = eig.eigenvectors().col(i).cwiseAbs();
+    const Eigen::VectorXd v = eig.eigenvectors().col(i).cwiseAbs();  // eigenvectors() is a temporary
     if (f > 8.0) (v[6] + v[7] > v[8] + v[9] ? hop_front : hop_rear).push_back(f);
   }
   std::sort(hz.begin(), hz.end());
