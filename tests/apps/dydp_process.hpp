@@ -76,17 +76,7 @@ class DydpProcessTest : public TempFolderTest {
   explicit DydpProcessTest(std::string prefix) : TempFolderTest(std::move(prefix)) {}
 
   /// Runs `dydp ARGS` (ARGS already quoted).
-  ProcessResult dydp(const std::string& args) const {
-    const std::filesystem::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = quote(DYDP_EXE) + " " + args + " >" + quote(out.string()) + " 2>" +
-                            quote(err.string());
-    const int raw = std::system(cmd.c_str());
-    ProcessResult r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = read_text(out);
-    r.err = read_text(err);
-    return r;
-  }
+  ProcessResult dydp(const std::string& args) const { return run_process(DYDP_EXE, args, dir_); }
 
   /// The text of a shipped file with `from` replaced by `to` (which must occur once).
   static std::string replaced(std::string text, const std::string& from, const std::string& to) {
