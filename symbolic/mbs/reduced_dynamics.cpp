@@ -227,7 +227,7 @@ void ReducedDynamics::tangent(const Result& r, const double* inputs, const doubl
 void ReducedDynamics::tangent_dynamics(const Result& r, const double* inputs, const double* p_in, int nd,
                                        const double* dinputs, const double* dp_in, const Matrix& dq,
                                        const Matrix& dqd, Matrix& dqdd) const {
-  const int n = model_.n, m = model_.m, nu = this->nu();
+  const int n = model_.n, m = model_.m;
   const double* p = params(p_in);
   const double* in = model_.inputs ? inputs : pad_.data();
   Matrix dinp, dp;
