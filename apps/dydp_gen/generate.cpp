@@ -90,7 +90,8 @@ std::vector<FunctionStats> generate(const GenerationInput& input, const Generati
   return stats;
 }
 
-std::string stats_json(const std::vector<FunctionStats>& functions, double seconds, std::size_t scheme_assignments) {
+std::string stats_json(const std::vector<FunctionStats>& functions, double seconds, std::size_t scheme_assignments,
+                       const std::vector<FunctionStats>& parts) {
   std::ostringstream s;
   s << "{\n  \"functions\": {";
   for (std::size_t i = 0; i < functions.size(); ++i) {
@@ -101,8 +102,18 @@ std::string stats_json(const std::vector<FunctionStats>& functions, double secon
       << "}, \"ops_total\": " << f.ops.total() << ", \"longest_line\": " << f.longest_line
       << ", \"repeated_right_hand_sides\": " << f.repeated_right_hand_sides << "}";
   }
-  s.precision(6);
   s << "\n  },\n";
+  if (!parts.empty()) {
+    s << "  \"parts\": {";
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      const FunctionStats& f = parts[i];
+      s << (i ? ",\n" : "\n") << "    \"" << f.name << "\": {\"equations\": " << f.equations_after
+        << ", \"ops\": {\"add\": " << f.ops.add << ", \"mul\": " << f.ops.mul << ", \"div\": " << f.ops.div
+        << ", \"call\": " << f.ops.call << "}, \"ops_total\": " << f.ops.total() << "}";
+    }
+    s << "\n  },\n";
+  }
+  s.precision(6);
   if (scheme_assignments) s << "  \"scheme_assignments\": " << scheme_assignments << ",\n";
   s << "  \"seconds\": " << std::fixed << seconds << "\n}\n";
   return s.str();

@@ -43,9 +43,10 @@ struct GenerationOptions {
 std::vector<FunctionStats> generate(const GenerationInput& input, const GenerationOptions& options);
 
 // stats.json as in the CLI contract of docs (DESIGN.md, section 5).
-// `scheme_assignments` (multibody models): the whole recursive scheme before elimination.
+// `scheme_assignments` (multibody models): the whole recursive scheme before elimination;
+// `parts`: parts of functions measured alone ("parts", same fields without the text measures).
 std::string stats_json(const std::vector<FunctionStats>& functions, double seconds,
-                       std::size_t scheme_assignments = 0);
+                       std::size_t scheme_assignments = 0, const std::vector<FunctionStats>& parts = {});
 
 // Writes `text` to `path` through a temporary file in the same folder, then renames it.
 void write_atomically(const std::filesystem::path& path, const std::string& text);

@@ -62,6 +62,16 @@ std::string number_array(const std::string& type, const std::string& name, const
   return s.str();
 }
 
+// A tangent list without its primal outputs: what only the derivatives read stays of the
+// primal part (elimination drops the rest).
+EquationList derivative_outputs_only(const EquationList& tangent) {
+  EquationList list(tangent.context());
+  for (const auto& a : tangent.assignments()) list.append(a);
+  for (std::size_t k = tangent.primal_outputs(); k < tangent.outputs().size(); ++k) list.add_output(tangent.outputs()[k]);
+  list.set_primal_split(tangent.primal_assignments(), 0);
+  return list;
+}
+
 // Independent coordinates: the model's, or the columns a pivoted QR of J (free columns, at the
 // initial configuration) leaves after picking the m best conditioned dependent ones.
 std::vector<int> choose_independent(const mbs::Model& model, bool& automatic) {
@@ -118,20 +128,21 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
     measure_text(f.definition, result.functions.back());
     return f;
   };
-  auto tangent = [&](const std::string& fn, const EquationList& list, std::vector<ArrayId> arrays) {
+  // `with_primal`: the tangent also writes the list's own outputs; without it only the derivative
+  // part is kept (the mass: M qdd itself is never read, only the columns M [B beta]).
+  auto tangent = [&](const std::string& fn, const EquationList& list, std::vector<ArrayId> arrays,
+                     bool with_primal = true) {
     const Direction direction = seeded(list.context(), arrays);
     EliminationStats stats;
     // differentiated from the compact scheme, so the tangent's size follows the primal's
-    const EquationList t =
-        compact(eliminate(differentiate(compact(list), std::span<const Direction>(&direction, 1)), &stats));
+    EquationList d = differentiate(compact(list), std::span<const Direction>(&direction, 1));
+    if (!with_primal) d = derivative_outputs_only(d);
+    const EquationList t = compact(eliminate(d, &stats));
     emit.function_name = fn;
     result.functions.push_back({fn, stats.before, t.size(), count_ops(t)});
     EmittedFunction f = emit_tangent(t, arrays, emit);
     measure_text(f.definition, result.functions.back());
     return f;
-  };
-  auto seeded_fn = [&](const std::string& fn, const EquationList& list, std::vector<ArrayId> arrays) {
-    return tangent(fn, list, std::move(arrays));
   };
 
   std::filesystem::create_directories(options.out_dir);
@@ -147,9 +158,19 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   // Four translation units, so that a large model's code compiles in parallel: dynamics (M and
   // the residual), its tangent, kinematics (constraints), sensors and Jacobians.
   std::vector<EmittedFunction> dynamics, residual_tangent, kinematics, sensors;
-  dynamics.push_back(seeded_fn(name + "_mass", *lists.inertial, {lists.qdd}));
+  dynamics.push_back(tangent(name + "_mass", *lists.inertial, {lists.qdd}, /*with_primal=*/false));
   dynamics.push_back(plain(name + "_residual", *lists.residual));
   residual_tangent.push_back(tangent(name + "_residual_tangent", *lists.residual, all_seeded));
+  auto part = [&](const std::string& label, const EquationList& list, std::size_t from, std::size_t to) {
+    EquationList alone(list.context());
+    for (const auto& a : list.assignments()) alone.append(a);
+    for (std::size_t k = from; k < to; ++k) alone.add_output(list.outputs()[k]);
+    const EquationList c = compact(eliminate(alone));
+    result.parts.push_back({label, list.size(), c.size(), count_ops(c)});
+  };
+  const std::size_t n = model.coordinates(), m = model.constraint_count();
+  part(name + "_residual.inverse_dynamics", *lists.residual, 0, n);
+  part(name + "_residual.constraint_accelerations", *lists.residual, n, n + m);
   kinematics.push_back(plain(name + "_constraints", *lists.constraints));
   kinematics.push_back(tangent(name + "_velocity_constraints_tangent", *lists.velocity_constraints, all_seeded));
   sensors.push_back(plain(name + "_sensors", *lists.sensors));

@@ -13,6 +13,9 @@ namespace dydp::gen {
 
 struct MbsGeneration {
   std::vector<FunctionStats> functions;
+  // Parts of emitted functions measured alone (not emitted): the residual's inverse dynamics
+  // (its first n outputs) and its constraint accelerations (the last m).
+  std::vector<FunctionStats> parts;
   std::size_t scheme_assignments = 0;  // the recursive scheme before elimination
   std::vector<std::string> independent;  // names of the independent coordinates
   bool independent_automatic = false;

@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
         std::cout << "\n";
       }
       if (stats) dydp::gen::write_atomically(std::filesystem::path(out_dir) / "stats.json",
-                                             dydp::gen::stats_json(g.functions, seconds, g.scheme_assignments));
+                                             dydp::gen::stats_json(g.functions, seconds, g.scheme_assignments, g.parts));
       return 0;
     }
     if (!ends_with(model_path, ".eqs")) {

@@ -15,7 +15,8 @@ using GeneratedTangent = void (*)(const double* q, const double* qd, const doubl
                                   const double* inp, const double* p, int nd, const double* seed_q,
                                   const double* seed_qd, const double* seed_qdd, const double* seed_inp,
                                   const double* seed_p, double* out, double* dout);
-// Tangent seeded on qdd only (the inertial pass: columns of M).
+// Tangent seeded on qdd only (the inertial pass: columns of M); it writes no primal outputs
+// (`out` is not touched).
 using GeneratedMassTangent = void (*)(const double* q, const double* qd, const double* qdd, const double* lam,
                                       const double* inp, const double* p, int nd, const double* seed_qdd,
                                       double* out, double* dout);
@@ -45,7 +46,7 @@ struct GeneratedModel {
   GeneratedMassTangent mass;                       // seeded on qdd: columns of M
   GeneratedFunction residual;                      // M qdd + c - J^T lam (n), J qdd + Jdot qd (m)
   GeneratedTangent residual_tangent;
-  GeneratedFunction constraints;                   // h (m), J (m x n row-major), Jdot qd (m)
+  GeneratedFunction constraints;                   // h (m), J (m x n row-major)
   GeneratedTangent velocity_constraints_tangent;   // h (m), J qd (m)
   GeneratedFunction sensors;
   GeneratedTangent sensors_tangent;

@@ -93,11 +93,10 @@ class Generator {
     };
     out_.inertial = std::make_unique<EquationList>(symbolic::eliminate(with_outputs(*all_, outputs("Mqdd", inertial))));
 
-    // The constraint kinematics. J from the relative kinematics of the cut points (a joint turns
-    // a point by e x r: constraint_jacobian()), J qd from it; Jdot qd = d(J qd)/dt at qdd = 0,
-    // the recursive time derivative of that compact scheme (every auxiliary of the cut points'
-    // placements gets its rate); J qdd + Jdot qd (the residual's constraint accelerations) from
-    // the same list.
+    // The constraint kinematics: h and J from the relative kinematics of the cut points (a joint
+    // turns a point by e x r: constraint_jacobian()), J qd from them. The residual's constraint
+    // accelerations J qdd + Jdot qd are the cut points' relative accelerations from the full
+    // pass's forward kinematics (cut_accelerations()); Jdot qd is the same at qdd = 0.
     const std::vector<std::vector<Expr>> J = constraint_jacobian();
     std::vector<Expr> jqd;
     for (int i = 0; i < mc; ++i) {
@@ -106,49 +105,22 @@ class Generator {
         if (!J[i][j].is_zero()) terms.push_back(J[i][j] * ctx_->element(out_.qd, j));
       jqd.push_back(all_->assign("HD" + std::to_string(i + 1), ctx_->sum(terms)));
     }
-    std::vector<Output> kinematic_outputs = outputs("h", h);
-    for (const Output& o : outputs("hdot", jqd)) kinematic_outputs.push_back(o);
-    for (int i = 0; i < mc; ++i)
-      for (int j = 0; j < n; ++j)
-        kinematic_outputs.push_back({"J[" + std::to_string(i) + "," + std::to_string(j) + "]", J[i][j].id()});
     out_.assignments_built = all_->size();
-    // compacted before differentiation, so the derivative follows the compact scheme
-    const EquationList kinematic = symbolic::compact(symbolic::eliminate(with_outputs(*all_, kinematic_outputs)));
-    Direction time_velocity{"v", "v", {}};
-    for (int j = 0; j < n; ++j)
-      time_velocity.seeds.push_back({ctx_->element(out_.q, j).id(), ctx_->element(out_.qd, j).id()});
-    const EquationList bias = symbolic::differentiate(kinematic, std::span(&time_velocity, 1));
-    const std::size_t kinematic_outputs_count = kinematic.outputs().size();
-    auto h_out = [&](int i) { return kinematic.outputs()[i].value; };
-    auto jqd_out = [&](int i) { return kinematic.outputs()[mc + i].value; };
-    auto J_out = [&](int i, int j) { return kinematic.outputs()[2 * mc + i * n + j].value; };
-    auto bias_out = [&](int i) { return bias.outputs()[kinematic_outputs_count + mc + i].value; };
-
     {
       std::vector<Output> o = outputs("r", residual);
-      for (int i = 0; i < mc; ++i) {
-        std::vector<Expr> terms{ctx_->expr(bias_out(i))};
-        for (int j = 0; j < n; ++j) {
-          const Expr Jij = ctx_->expr(J_out(i, j));
-          if (!Jij.is_zero()) terms.push_back(Jij * ctx_->element(out_.qdd, j));
-        }
-        o.push_back({"a[" + std::to_string(i) + "]", ctx_->sum(terms).id()});
-      }
-      out_.residual = merged(outputs("r", residual), {&bias}, std::move(o));
+      for (const Output& a : outputs("a", cut_accelerations())) o.push_back(a);
+      out_.residual = merged(o, {}, o);
     }
     {
-      std::vector<Output> o;
-      for (int i = 0; i < mc; ++i) o.push_back({"h[" + std::to_string(i) + "]", h_out(i)});
+      std::vector<Output> o = outputs("h", h);
       for (int i = 0; i < mc; ++i)
-        for (int j = 0; j < n; ++j) o.push_back({"J[" + std::to_string(i) + "," + std::to_string(j) + "]", J_out(i, j)});
-      for (int i = 0; i < mc; ++i) o.push_back({"Jdqd[" + std::to_string(i) + "]", bias_out(i)});
-      out_.constraints = merged({}, {&bias}, std::move(o));
+        for (int j = 0; j < n; ++j) o.push_back({"J[" + std::to_string(i) + "," + std::to_string(j) + "]", J[i][j].id()});
+      out_.constraints = merged(o, {}, o);
     }
     {
-      std::vector<Output> o;
-      for (int i = 0; i < mc; ++i) o.push_back({"h[" + std::to_string(i) + "]", h_out(i)});
-      for (int i = 0; i < mc; ++i) o.push_back({"hdot[" + std::to_string(i) + "]", jqd_out(i)});
-      out_.velocity_constraints = merged({}, {&kinematic}, std::move(o));
+      std::vector<Output> o = outputs("h", h);
+      for (const Output& a : outputs("hdot", jqd)) o.push_back(a);
+      out_.velocity_constraints = merged(o, {}, o);
     }
     out_.sensors = std::make_unique<EquationList>(symbolic::eliminate(with_outputs(*all_, outputs("s", sensors))));
 
@@ -332,11 +304,6 @@ class Generator {
   }
   V3 anchor(PointRef p) { return vec(m_.bodies[p.body].anchors[p.anchor].position); }
   V3 point_position(PointRef p) { return body_origin(p.body) + body_rotation(p.body).apply(anchor(p)); }
-  V3 point_velocity(PointRef p) {
-    const int f = m_.bodies[p.body].frame;
-    if (f < 0) return zero3();
-    return rot_[f].apply(velocity_[f] + cross(omega_[f], anchor(p)));
-  }
 
   // The Newton-Euler passes. `full`: gravity, velocities, loads, force elements and cut forces;
   // otherwise the inertial pass (M qdd). Returns the joint forces.
@@ -371,12 +338,6 @@ class Generator {
 
     // External wrenches on each body about its frame origin, body components.
     std::vector<V3> ext_f(m_.bodies.size(), zero3()), ext_n(m_.bodies.size(), zero3());
-    auto apply = [&](PointRef p, const V3& ground_force) {
-      if (p.body == 0) return;
-      const V3 f = body_rotation(p.body).apply_transpose(ground_force);
-      ext_f[p.body] = ext_f[p.body] + f;
-      ext_n[p.body] = ext_n[p.body] + cross(anchor(p), f);
-    };
     // A force given in the components of joint frame `frame`, at a point: turned into the
     // point's body frame by the relative rotation when `frame` is an ancestor (for a spring
     // between chassis and wishbone, one joint's rotation) instead of through the ground.
@@ -443,15 +404,17 @@ class Generator {
           continue;
         }
         ++spring;
-        const V3 d = assign("DS", spring - 1, point_position(e.b) - point_position(e.a));
+        // in the frame of the two bodies' common ancestor, like the link forces
+        const int c = common_frame(m_.bodies[e.a.body].frame, m_.bodies[e.b.body].frame);
+        const V3 d = assign("DS", spring - 1, point_in(e.b, c) - point_in(e.a, c));
         const Expr length = all_->assign("LS" + std::to_string(spring), symbolic::sqrt(dot(d, d)));
-        const V3 dv = point_velocity(e.b) - point_velocity(e.a);
+        const V3 dv = velocity_in(e.b, c) - velocity_in(e.a, c);
         const Expr rate = all_->assign("LSD" + std::to_string(spring), dot(d, dv) / length);
         const Expr tension = all_->assign("FS" + std::to_string(spring),
             val(e.stiffness) * (length - val(e.rest_length)) + val(e.damping) * rate);
         const V3 f = (tension / length) * d;
-        apply(e.a, f);
-        apply(e.b, -f);
+        apply_in(e.a, c, f);
+        apply_in(e.b, c, -f);
       }
     }
 
@@ -598,13 +561,23 @@ class Generator {
   }
 
   // v, given in the components of joint frame `frame` (-1: the ground), in body's frame.
-  V3 to_body(int body, int frame, const V3& v) {
-    const int fb = m_.bodies[body].frame;
-    if (fb == frame) return v;
-    bool ancestor = frame < 0;
-    for (int k = fb; k >= 0 && !ancestor; k = m_.joints[k].parent) ancestor = k == frame;
-    if (ancestor) return relative_placement(fb, frame).rot.apply_transpose(v);
-    return body_rotation(body).apply_transpose(frame_rotation(frame).apply(v));
+  V3 to_body(int body, int frame, const V3& v) { return change_frame(frame, m_.bodies[body].frame, v); }
+
+  // Whether joint frame c (-1: the ground) is k or one of its ancestors.
+  bool carries(int c, int k) const {
+    if (c < 0) return true;
+    for (; k >= 0; k = m_.joints[k].parent)
+      if (k == c) return true;
+    return false;
+  }
+  // v, given in the components of joint frame `from`, in those of `to` (-1: the ground): by the
+  // rotation relative to the nearer one when one carries the other (a corner body and the
+  // chassis: the corner's own joints), through the ground otherwise.
+  V3 change_frame(int from, int to, const V3& v) {
+    if (from == to) return v;
+    if (carries(to, from)) return relative_placement(from, to).rot.apply(v);
+    if (carries(from, to)) return relative_placement(to, from).rot.apply_transpose(v);
+    return frame_rotation(to).apply_transpose(frame_rotation(from).apply(v));
   }
 
   // The nearest common ancestor of two joint frames (-1: the ground).
@@ -682,15 +655,98 @@ class Generator {
     return {rb.apply(constant(c.axis_b)), {ra.apply(constant(c.normals_a[0])), ra.apply(constant(c.normals_a[1]))}};
   }
 
-  V3 point_acceleration(PointRef p) {
-    // ground components; the scheme's accelerations are relative to a ground accelerating at -g
+  // Velocity and acceleration (the scheme's, ground at -g) of a point, in the components of the
+  // frame c its body's frame descends from (-1: the ground), from the full pass.
+  struct PointMotion {
+    V3 velocity, acceleration;
+  };
+  PointMotion point_motion(PointRef p, int c) {
     const int f = m_.bodies[p.body].frame;
-    if (f < 0) return zero3();
+    if (f < 0) {  // a ground point (then c is the ground too)
+      const V3 g{{ctx_->constant(-m_.gravity[0]), ctx_->constant(-m_.gravity[1]), ctx_->constant(-m_.gravity[2])}};
+      return {zero3(), g};
+    }
     const V3 r = anchor(p);
-    const V3 g{{ctx_->constant(m_.gravity[0]), ctx_->constant(m_.gravity[1]), ctx_->constant(m_.gravity[2])}};
-    return rot_[f].apply(full_acc_[f] + cross(full_alpha_[f], r) + cross(omega_[f], cross(omega_[f], r))) + g;
+    const V3 wr = cross(omega_[f], r);
+    const V3 v = velocity_[f] + wr;
+    const V3 a = full_acc_[f] + cross(full_alpha_[f], r) + cross(omega_[f], wr);
+    if (f == c) return {v, a};
+    const Rot rot = relative_placement(f, c).rot;
+    return {rot.apply(v), rot.apply(a)};
   }
 
+  // The second time derivative of every cut equation, J qdd + Jdot qd, from the full pass's
+  // velocities and accelerations. A cut written in the components of a moving frame c (angular
+  // velocity w, acceleration al, own components): with d = R_c^T (x_b - x_a),
+  // d' = R_c^T dx' - w x d and d'' = R_c^T dx'' - 2 w x d' - al x d - w x (w x d).
+  std::vector<Expr> cut_accelerations() {
+    std::vector<Expr> rows;
+    int row = 0;
+    for (std::size_t ci = 0; ci < m_.cuts.size(); ++ci) {
+      const Cut& c = m_.cuts[ci];
+      const int frame = cut_frame(c);
+      const std::string tag = std::to_string(ci + 1) + "_";
+      const PointMotion b = point_motion(c.b, frame), a = point_motion(c.a, frame);
+      const V3 dv = assign("DCV" + tag, 0, b.velocity - a.velocity);  // R_c^T dx'
+      const V3 da = b.acceleration - a.acceleration;                   // R_c^T dx''
+      const V3 d = cut_vector(ci);
+      if (c.type == Cut::Type::Distance) {
+        // h = (d.d - L^2) / 2L: h'' = (dx'.dx' + dx.dx'') / L, in any one frame's components
+        const Expr inverse_length = 1.0 / val(c.length);
+        rows.push_back(all_->assign("HA" + std::to_string(++row), (dot(dv, dv) + dot(d, da)) * inverse_length));
+        continue;
+      }
+      V3 dd = da;
+      if (frame >= 0) {
+        const V3 w = omega_[frame], al = full_alpha_[frame];
+        const V3 wd = assign("DCW" + tag, 0, cross(w, d));
+        const V3 rate = assign("DCR" + tag, 0, dv - wd);  // d'
+        dd = da - ctx_->constant(2.0) * cross(w, rate) - cross(al, d) - cross(w, wd);
+      }
+      dd = assign("DCA" + tag, 0, dd);
+      if (c.type == Cut::Type::Ball) {
+        for (int comp : c.components) rows.push_back(all_->assign("HA" + std::to_string(++row), dd[comp]));
+        continue;
+      }
+      for (int comp = 0; comp < 3; ++comp) rows.push_back(all_->assign("HA" + std::to_string(++row), dd[comp]));
+      // hinge alignment h = n . b (ground components): h' = (w_b - w_a) . (b x n),
+      // h'' = (al_b - al_a) . (b x n) + (w_b - w_a) . ((w_b x b) x n + b x (w_a x n))
+      const HingeAxes axes = hinge_axes(c);
+      auto absolute = [&](int body, const std::vector<V3>& own) {
+        const int f = m_.bodies[body].frame;
+        return f < 0 ? zero3() : rot_[f].apply(own[f]);
+      };
+      const V3 wa = absolute(c.a.body, omega_), wb = absolute(c.b.body, omega_);
+      const V3 dal = absolute(c.b.body, full_alpha_) - absolute(c.a.body, full_alpha_);
+      const V3 rate_b = cross(wb, axes.b);
+      for (const V3& normal : axes.normals) {
+        const V3 bn = cross(axes.b, normal);
+        const V3 rate = cross(rate_b, normal) + cross(axes.b, cross(wa, normal));
+        rows.push_back(all_->assign("HA" + std::to_string(++row), dot(dal, bn) + dot(wb - wa, rate)));
+      }
+    }
+    return rows;
+  }
+
+  // A point's absolute velocity and acceleration (the true one, gravity removed) in the
+  // components of joint frame `to`, from its body frame's own components.
+  V3 velocity_in(PointRef p, int to) {
+    const int f = m_.bodies[p.body].frame;
+    if (f < 0) return zero3();
+    return change_frame(f, to, velocity_[f] + cross(omega_[f], anchor(p)));
+  }
+  V3 acceleration_in(PointRef p, int to) {
+    const int f = m_.bodies[p.body].frame;
+    const V3 g{{ctx_->constant(m_.gravity[0]), ctx_->constant(m_.gravity[1]), ctx_->constant(m_.gravity[2])}};
+    const V3 gravity = change_frame(-1, to, g);
+    if (f < 0) return zero3();
+    const V3 r = anchor(p);
+    return change_frame(f, to, full_acc_[f] + cross(full_alpha_[f], r) + cross(omega_[f], cross(omega_[f], r))) + gravity;
+  }
+
+  // Sensors in the components of their frame, each through the rotation relative to the frame
+  // when that frame carries the point (the chassis frame and a wheel centre: the corner's joints
+  // only); lengths in the frame of the two bodies' common ancestor, like the link forces.
   std::vector<Expr> sensor_values() {
     std::vector<Expr> values;
     int index = 0;
@@ -698,24 +754,27 @@ class Generator {
       ++index;
       const std::string name = "SENS" + std::to_string(index) + "_";
       V3 v;
+      const int frame = m_.bodies[s.frame].frame;
       switch (s.type) {
         case Sensor::Type::AngularVelocity: {
           const int f = m_.bodies[s.a.body].frame;
-          v = body_rotation(s.frame).apply_transpose(f < 0 ? zero3() : rot_[f].apply(omega_[f]));
+          v = f < 0 ? zero3() : change_frame(f, frame, omega_[f]);
           break;
         }
         case Sensor::Type::Position:
-          v = body_rotation(s.frame).apply_transpose(point_position(s.a) - body_origin(s.frame));
+          if (carries(frame, m_.bodies[s.a.body].frame)) v = point_in(s.a, frame);
+          else v = body_rotation(s.frame).apply_transpose(point_position(s.a) - body_origin(s.frame));
           break;
-        case Sensor::Type::Velocity: v = body_rotation(s.frame).apply_transpose(point_velocity(s.a)); break;
-        case Sensor::Type::Acceleration: v = body_rotation(s.frame).apply_transpose(point_acceleration(s.a)); break;
+        case Sensor::Type::Velocity: v = velocity_in(s.a, frame); break;
+        case Sensor::Type::Acceleration: v = acceleration_in(s.a, frame); break;
         case Sensor::Type::Joint:
           v = V3{{ctx_->element(out_.q, s.joint), ctx_->element(out_.qd, s.joint), ctx_->element(out_.qdd, s.joint)}};
           break;
         case Sensor::Type::Length: {
-          const V3 d = assign(name + "D", 0, point_position(s.b) - point_position(s.a));
+          const int c = common_frame(m_.bodies[s.a.body].frame, m_.bodies[s.b.body].frame);
+          const V3 d = assign(name + "D", 0, point_in(s.b, c) - point_in(s.a, c));
           const Expr length = all_->assign(name + "L", symbolic::sqrt(dot(d, d)));
-          const Expr rate = dot(d, point_velocity(s.b) - point_velocity(s.a)) / length;
+          const Expr rate = dot(d, velocity_in(s.b, c) - velocity_in(s.a, c)) / length;
           const Expr extension = length - val(s.reference);
           v = V3{{s.compression ? -extension : extension, s.compression ? -rate : rate, ctx_->zero()}};
           break;

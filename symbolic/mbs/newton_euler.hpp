@@ -20,9 +20,10 @@ struct ModelLists {
   // Outputs M qdd of the inertial pass (qd = 0, no gravity, no loads): seeded on qdd, its
   // tangent gives the columns of M.
   std::unique_ptr<symbolic::EquationList> inertial;
-  // r = M qdd + c - J^T lam (n outputs), then the constraint accelerations J qdd + Jdot qd (m).
+  // r = M qdd + c - J^T lam (n outputs), then the constraint accelerations J qdd + Jdot qd (m),
+  // the cut points' relative accelerations from the full pass (Jdot qd: the same at qdd = 0).
   std::unique_ptr<symbolic::EquationList> residual;
-  // h (m), J (m x n, row-major), Jdot qd (m).
+  // h (m), J (m x n, row-major).
   std::unique_ptr<symbolic::EquationList> constraints;
   // h (m), J qd (m): its tangent gives the dependent coordinates' and velocities' derivatives.
   std::unique_ptr<symbolic::EquationList> velocity_constraints;

@@ -62,8 +62,8 @@ void ReducedDynamics::solve_kinematics(const double* u, const double* ud, const 
   }
   const double* in = model_.inputs ? inputs : pad_.data();
 
-  // Constraints: h, J, Jdot qd.
-  std::vector<double> hj(m + m * n + m + 1);
+  // Constraints: h, J.
+  std::vector<double> hj(m + m * n + 1);
   r.J.resize(m, n);
   auto evaluate_constraints = [&] {
     model_.constraints(r.q.data(), r.qd.data(), r.qdd.data(), lam_zero.data(), in, p, hj.data());

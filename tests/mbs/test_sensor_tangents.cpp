@@ -192,11 +192,11 @@ Reference oracle_sensors(NumericDynamics& oracle, const GeneratedModel& g) {
   };
 }
 
-// (h, J qd) from the generated primal `constraints`: h (m), J (m x n row-major), Jdot qd (m).
+// (h, J qd) from the generated primal `constraints`: h (m), J (m x n row-major).
 Reference velocity_constraints(const GeneratedModel& g) {
   return [&g](const Args& x) {
     const int m = g.m, n = g.n;
-    const Vector all = generated_outputs(g.constraints, m + m * n + m, x);
+    const Vector all = generated_outputs(g.constraints, m + m * n, x);
     const Matrix J = Eigen::Map<const Eigen::Matrix<double, -1, -1, Eigen::RowMajor>>(all.data() + m, m, n);
     Vector v(2 * m);
     v << all.head(m), J * x.qd.head(n);
