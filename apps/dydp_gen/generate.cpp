@@ -100,7 +100,9 @@ std::string stats_json(const std::vector<FunctionStats>& functions, double secon
       << ", \"equations_after\": " << f.equations_after << ", \"ops\": {\"add\": " << f.ops.add
       << ", \"mul\": " << f.ops.mul << ", \"div\": " << f.ops.div << ", \"call\": " << f.ops.call
       << "}, \"ops_total\": " << f.ops.total() << ", \"longest_line\": " << f.longest_line
-      << ", \"repeated_right_hand_sides\": " << f.repeated_right_hand_sides << "}";
+      << ", \"repeated_right_hand_sides\": " << f.repeated_right_hand_sides;
+    if (f.ops_per_direction) s << ", \"ops_per_direction\": " << f.ops_per_direction;
+    s << "}";
   }
   s << "\n  },\n";
   if (!parts.empty()) {

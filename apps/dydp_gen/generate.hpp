@@ -28,6 +28,9 @@ struct FunctionStats {
   // an earlier assignment's in the same function.
   std::size_t longest_line = 0;
   std::size_t repeated_right_hand_sides = 0;
+  // Tangents: the operations of the loop over directions (what each direction costs; the
+  // seed-free part is evaluated once with the primal).
+  std::uint64_t ops_per_direction = 0;
 };
 
 // longest_line and repeated_right_hand_sides of one emitted function's text.

@@ -140,6 +140,10 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
     const EquationList t = compact(eliminate(d, &stats));
     emit.function_name = fn;
     result.functions.push_back({fn, stats.before, t.size(), count_ops(t)});
+    EquationList per_direction(t.context());
+    for (std::size_t k = t.primal_assignments(); k < t.size(); ++k) per_direction.append(t.assignments()[k]);
+    for (std::size_t k = t.primal_outputs(); k < t.outputs().size(); ++k) per_direction.add_output(t.outputs()[k]);
+    result.functions.back().ops_per_direction = count_ops(per_direction).total();
     EmittedFunction f = emit_tangent(t, arrays, emit);
     measure_text(f.definition, result.functions.back());
     return f;
@@ -172,6 +176,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   part(name + "_residual.inverse_dynamics", *lists.residual, 0, n);
   part(name + "_residual.constraint_accelerations", *lists.residual, n, n + m);
   kinematics.push_back(plain(name + "_constraints", *lists.constraints));
+  kinematics.push_back(tangent(name + "_constraints_tangent", *lists.position_constraints, all_seeded));
   kinematics.push_back(tangent(name + "_velocity_constraints_tangent", *lists.velocity_constraints, all_seeded));
   sensors.push_back(plain(name + "_sensors", *lists.sensors));
   sensors.push_back(tangent(name + "_sensors_tangent", *lists.sensors, all_seeded));
@@ -263,7 +268,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += "    " + name + "_mass, " + name + "_residual, " + name + "_residual_tangent, " + name + "_constraints,\n";
   d += "    " + name + "_velocity_constraints_tangent, " + name + "_sensors, " + name + "_sensors_tangent,\n";
   d += "    " + std::to_string(model.load_input_count()) + ", load_names, load_widths, sensor_units,\n";
-  d += "    jacobian_nonzero};\n\n";
+  d += "    jacobian_nonzero, " + name + "_constraints_tangent};\n\n";
   d += "}  // namespace dydp::generated\n";
   write_atomically(options.out_dir / (name + "_model.cpp"), d);
   return result;

@@ -58,6 +58,7 @@ struct GeneratedModel {
   const char* const* sensor_units;  // SI unit of each sensor port ("m", "m/s", "rad", ...)
   // m x n row-major: 0 where J is zero whatever the state (a joint that does not move the cut).
   const int* jacobian_nonzero;
+  GeneratedTangent constraints_tangent;  // h (m) and its tangent: dh for dq (cheaper than h, J qd)
 };
 
 }  // namespace dydp::mbs

@@ -122,6 +122,7 @@ class Generator {
       for (const Output& a : outputs("hdot", jqd)) o.push_back(a);
       out_.velocity_constraints = merged(o, {}, o);
     }
+    out_.position_constraints = merged(outputs("h", h), {}, outputs("h", h));
     out_.sensors = std::make_unique<EquationList>(symbolic::eliminate(with_outputs(*all_, outputs("s", sensors))));
 
     std::vector<Direction> along_q;

@@ -27,6 +27,8 @@ struct ModelLists {
   std::unique_ptr<symbolic::EquationList> constraints;
   // h (m), J qd (m): its tangent gives the dependent coordinates' and velocities' derivatives.
   std::unique_ptr<symbolic::EquationList> velocity_constraints;
+  // h (m) alone: its tangent gives dh for the dependent coordinates' derivatives.
+  std::unique_ptr<symbolic::EquationList> position_constraints;
   std::unique_ptr<symbolic::EquationList> sensors;
   struct Named {
     std::string name;

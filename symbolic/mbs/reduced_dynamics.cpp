@@ -203,12 +203,12 @@ void ReducedDynamics::tangent_kinematics(const Result& r, const double* inputs, 
   }
   const Vector lam = r.lam.size() >= std::max(m, 1) ? r.lam : Vector::Zero(std::max(m, 1));  // not read here
   if (m > 0) {
-    // dh = Ju du + Jv dv + h_p dp = 0, then d(J qd) = 0 likewise for dv_dot.
+    // dh = Ju du + Jv dv + h_p dp = 0 (h's own tangent), then d(J qd) = 0 likewise for dv_dot.
     std::vector<double> out(2 * m);
-    Matrix dout(2 * m, nd);
-    model_.velocity_constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), in, p, nd, dq.data(),
-                                        dqd.data(), dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
-    const Matrix dv = -r.Jv.solve(Matrix(dout.topRows(m)));
+    Matrix dout(2 * m, nd), dh(m, nd);
+    model_.constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), in, p, nd, dq.data(), dqd.data(),
+                               dqdd.data(), dinp.data(), dp.data(), out.data(), dh.data());
+    const Matrix dv = -r.Jv.solve(dh);
     for (int i = 0; i < m; ++i) dq.row(v_[i]) = dv.row(i);
     model_.velocity_constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), in, p, nd, dq.data(),
                                         dqd.data(), dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());

@@ -204,6 +204,11 @@ Reference velocity_constraints(const GeneratedModel& g) {
   };
 }
 
+// h alone from the generated primal `constraints`.
+Reference position_constraints(const GeneratedModel& g) {
+  return [&g](const Args& x) { return Vector(generated_outputs(g.constraints, g.m + g.m * g.n, x).head(g.m)); };
+}
+
 Reference residual(const GeneratedModel& g) {
   return [&g](const Args& x) { return generated_outputs(g.residual, g.n + g.m, x); };
 }
@@ -251,6 +256,15 @@ TEST_P(Tangents, VelocityConstraintsMatchCentralDifferencesOfConstraints) {
                  velocity_constraints(g), 1e-13, 22);
 }
 
+TEST_P(Tangents, PositionConstraintsMatchCentralDifferencesOfConstraints) {
+  Fixture f(GetParam());
+  ASSERT_NE(f.g, nullptr);
+  const GeneratedModel& g = *f.g;
+  if (g.m == 0) GTEST_SKIP() << g.name << " has no constraints";
+  check_function("position constraints", f, g.constraints_tangent, g.m, position_constraints(g),
+                 position_constraints(g), 1e-13, 25);
+}
+
 TEST_P(Tangents, ResidualMatchesCentralDifferencesOfResidual) {
   Fixture f(GetParam());
   ASSERT_NE(f.g, nullptr);
@@ -290,6 +304,11 @@ TEST(TangentCheck, FailsOnOneWrongEntry) {
   v.dout.cwiseAbs().maxCoeff(&j, &d);
   EXPECT_NONFATAL_FAILURE(check_entries("velocity constraints", g, a, dirs, off(v, j, d, v.dout(j, d) * (1 + 1e-5)),
                                         velocity_constraints(g)),
+                          "central difference");
+  const Tangent h = call_tangent(g.constraints_tangent, g.m, g, a, dirs);
+  h.dout.cwiseAbs().maxCoeff(&j, &d);
+  EXPECT_NONFATAL_FAILURE(check_entries("position constraints", g, a, dirs, off(h, j, d, h.dout(j, d) * (1 + 1e-5)),
+                                        position_constraints(g)),
                           "central difference");
   const Tangent r = call_tangent(g.residual_tangent, g.n + g.m, g, a, dirs);
   r.dout.cwiseAbs().maxCoeff(&j, &d);
