@@ -6,7 +6,6 @@
 
 #include <cvodes/cvodes.h>
 #include <nvector/nvector_serial.h>
-#include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
@@ -15,6 +14,7 @@
 #include <memory>
 
 #include "engine/cpu_clock.hpp"
+#include "engine/dense_lu_solver.hpp"
 #include "engine/errors.hpp"
 #include "engine/timeline.hpp"
 #include "engine/recorder.hpp"
@@ -206,7 +206,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   check(CVodeSetMinStep(S.mem, d.solver.min_step), "CVodeSetMinStep");
   if (bdf) {
     S.A = SUNDenseMatrix(n_cv, n_cv, S.ctx);
-    S.LS = SUNLinSol_Dense(S.y, S.A, S.ctx);
+    S.LS = make_dense_lu_solver(S.ctx, n_cv);
     check(CVodeSetLinearSolver(S.mem, S.LS, S.A), "CVodeSetLinearSolver");
     check(CVodeSetJacFn(S.mem, jacobian), "CVodeSetJacFn");
   } else {

@@ -1,0 +1,16 @@
+// The Newton iteration's linear solver for CVODES: the dense matrix SUNDIALS forms (I - gamma J)
+// factored by Eigen's partial-pivoting LU (blocked and vectorised) instead of SUNDIALS' own
+// column-by-column GETRF/GETRS, which on the sedan's 52 states took about a seventh of the
+// main job. A SUNDIALS linear solver of the direct type on a dense SUNMatrix, so CVODES uses it
+// like SUNLinSol_Dense.
+#pragma once
+
+#include <sundials/sundials_context.h>
+#include <sundials/sundials_linearsolver.h>
+
+namespace dydp::engine {
+
+// A solver for n x n dense matrices; free it with SUNLinSolFree.
+SUNLinearSolver make_dense_lu_solver(SUNContext context, int n);
+
+}  // namespace dydp::engine
