@@ -14,6 +14,7 @@
 #include "engine/duplicate_keys.hpp"
 #include "engine/errors.hpp"
 #include "engine/graph_builder.hpp"
+#include "engine/nominal_overrides.hpp"
 #include "engine/scene_relations.hpp"
 
 namespace dydp::engine {
@@ -172,7 +173,7 @@ Node read_block(const SceneReader& r, const YAML::Node& key, const YAML::Node& b
   for (auto kv : body) {
     const std::string k = kv.first.Scalar();
     const std::string field = node.name + "." + k;
-    if (k == "type") continue;
+    if (k == "type" || k == "nominal") continue;
     seen.insert(k);
     auto ps = std::find_if(type.parameters.begin(), type.parameters.end(),
                            [&](const ParamSpec& s) { return s.name == k; });
@@ -235,6 +236,9 @@ Node read_block(const SceneReader& r, const YAML::Node& key, const YAML::Node& b
     node.p_line.push_back(line);
   }
   node.block = type.make(settings);
+  node.state_nominal = body["nominal"]
+                           ? read_nominal_overrides(r.file(), node.name, body["nominal"], *node.block)
+                           : node.block->state_nominals();
   node.objective = dynamic_cast<const Objective*>(node.block.get());
   node.settings = std::make_shared<const BlockSettings>(std::move(settings));
   check_block(r.file(), node, node.p, d.time, &warnings);

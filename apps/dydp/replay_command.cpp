@@ -74,6 +74,7 @@ int replay_command(const ReplayArgs& args) {
     throw engine::InputError(args.input, 1, "t", "the first column must be the time t [s]");
   const std::string input = std::filesystem::absolute(args.input).string();
   engine::Diagram d = engine::load_scene(args.scene, parse_sets(args.sets), {{"input_file", input}});
+  engine::apply_solver_overrides(d, args.solver);
   bool takes_input = false;
   for (const auto& n : d.nodes)
     for (const auto& s : n.type->settings) takes_input = takes_input || s.name == "input_file";
