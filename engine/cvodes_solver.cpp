@@ -361,6 +361,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
     const double stop = next_break < breaks.size() ? breaks[next_break] : tf;
     check(CVodeSetStopTime(S.mem, stop), "CVodeSetStopTime");
     long interval_steps = 0;
+    bool at_target = false;  // S.y holds the solution at target (a step ended there)
     while (reached < target) {
       if (++interval_steps > d.solver.max_steps)
         fail(CV_TOO_MUCH_WORK, reached,
@@ -371,8 +372,11 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
       if (nx > 0 && CVodeGetEstLocalErrors(S.mem, local_errors) == CV_SUCCESS &&
           CVodeGetErrWeights(S.mem, weights) == CV_SUCCESS)
         limiters.add_step(NV_DATA_S(local_errors), NV_DATA_S(weights));
+      at_target = reached == target;
     }
-    if (reached > target) check(CVodeGetDky(S.mem, target, 0, S.y), "CVodeGetDky");
+    // Otherwise the last step went past target, in this interval or an earlier one (it may have
+    // ended exactly on the next output): interpolate.
+    if (!at_target) check(CVodeGetDky(S.mem, target, 0, S.y), "CVodeGetDky");
     t = target;
     if (timeline.is_output(target)) record(target);
     if (next_break < breaks.size() && breaks[next_break] == target && target < tf) {

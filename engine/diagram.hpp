@@ -33,6 +33,9 @@ struct SolverSpec {
   /// CVODES: include the sensitivities (and quadrature sensitivities) in the error test.
   /// Off, the steps are chosen for the states alone: cheaper, sensitivities less controlled.
   bool sens_error_test = true;
+  /// Absolute tolerances scaled by the states' nominal magnitudes (atol * nominal_i); false:
+  /// atol as it stands for every state, the nominal magnitudes ignored.
+  bool nominal_scaling = true;
 };
 
 struct SceneParameter {

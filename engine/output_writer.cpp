@@ -77,6 +77,7 @@ std::string run_json(const Diagram& d, const RunResult& r) {
       {"atol", s.atol},
       {"fixed_step", s.step},
       {"sens_error_test", d.solver.sens_error_test},
+      {"nominal_scaling", d.solver.nominal_scaling},
       {"parameters", parameters},
       {"sensitivities", r.sensitivity_names},
       {"states", d.num_states},

@@ -91,7 +91,7 @@ void read_time(const SceneReader& r, const YAML::Node& n, TimeSpec& time) {
 
 void read_solver(const SceneReader& r, const YAML::Node& n, const TimeSpec& time, SolverSpec& s) {
   if (!n) return check_solver_relations(r.file(), n, s, time);
-  r.allow_keys(n, "solver", {"method", "rtol", "atol", "step", "max_steps", "min_step", "sens_error_test"});
+  r.allow_keys(n, "solver", {"method", "rtol", "atol", "step", "max_steps", "min_step", "sens_error_test", "nominal_scaling"});
   if (n["method"]) {
     s.method = r.text(n["method"], "solver.method");
     if (s.method != "bdf" && s.method != "adams" && s.method != "rk4" && s.method != "sdirk2")
@@ -104,6 +104,11 @@ void read_solver(const SceneReader& r, const YAML::Node& n, const TimeSpec& time
     const std::string v = r.text(e, "solver.sens_error_test");
     if (v != "true" && v != "false") r.fail(e, "solver.sens_error_test", "expected true or false");
     s.sens_error_test = v == "true";
+  }
+  if (const YAML::Node e = n["nominal_scaling"]) {
+    const std::string v = r.text(e, "solver.nominal_scaling");
+    if (v != "true" && v != "false") r.fail(e, "solver.nominal_scaling", "expected true or false");
+    s.nominal_scaling = v == "true";
   }
   if (n["max_steps"]) {
     const double v = r.number(n["max_steps"], "solver.max_steps");

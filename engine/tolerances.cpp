@@ -23,12 +23,14 @@ std::string state_label(const Diagram& d, int i) {
 
 AbsoluteTolerances absolute_tolerances(const Diagram& d, double atol, int directions) {
   AbsoluteTolerances t;
-  const std::vector<double> nominal = state_nominals(d);
+  const std::vector<double> nominal =
+      d.solver.nominal_scaling ? state_nominals(d) : std::vector<double>(d.num_states, 1.0);
   for (double v : nominal) t.states.push_back(atol * v);
   t.quadratures.assign(d.num_quadratures, atol);
-  for (const Node& n : d.nodes)
-    for (int i = 0; i < n.block->num_quadratures(); ++i)
-      t.quadratures[n.quad_offset + i] = atol * n.block->quadrature_nominals()[i];
+  if (d.solver.nominal_scaling)
+    for (const Node& n : d.nodes)
+      for (int i = 0; i < n.block->num_quadratures(); ++i)
+        t.quadratures[n.quad_offset + i] = atol * n.block->quadrature_nominals()[i];
   for (int dir = 0; dir < directions; ++dir) {
     // dx/dp is held to atol * nominal / |p|: a stiffness of 1e5 N/m and a mass of 400 kg have
     // their sensitivities held to the same relative accuracy (p = 0: unit scale).

@@ -25,7 +25,7 @@ std::vector<double> state_nominals(const Diagram& d);
 std::string state_label(const Diagram& d, int i);
 
 /// The absolute tolerances for atol over `directions` sensitivity directions
-/// (d.sensitivities[0 .. directions)).
+/// (d.sensitivities[0 .. directions)); with d.solver.nominal_scaling off, every nominal is 1.
 AbsoluteTolerances absolute_tolerances(const Diagram& d, double atol, int directions);
 
 }  // namespace dydp::engine

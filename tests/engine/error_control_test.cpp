@@ -9,6 +9,8 @@
 // the fast one sets the step until the slow one's tolerance is made far tighter.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "engine/diagram.hpp"
@@ -63,6 +65,11 @@ class ErrorControl : public test::TempFolderTest {
                  "outputs: [slow.x, fast.x]\n");
   }
 
+  static std::string read(const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }
+
   static double share_of(const RunStats& s, const std::string& block) {
     double share = 0.0;
     for (const LimitingState& l : s.limiting_states)
@@ -114,6 +121,21 @@ TEST_F(ErrorControl, NominalTimesAtolIsTheToleranceCvodesGets) {
   ASSERT_EQ(scaled.values.size(), plain.values.size());
   for (size_t i = 0; i < plain.values.size(); ++i) EXPECT_EQ(scaled.values[i], plain.values[i]);
   for (size_t i = 0; i < plain.tangents.size(); ++i) EXPECT_EQ(scaled.tangents[i], plain.tangents[i]);
+}
+
+TEST_F(ErrorControl, WithoutNominalScalingAtolHoldsEveryStateAsItStands) {
+  // nominal_scaling: false ignores the nominals: the run with nominal 2^-10 is then the run with
+  // nominal 1, and it is not the scaled one.
+  const std::string nominal = "{x: 0.0009765625, v: 0.0009765625}";
+  std::string text = read(decaying("1.0e-6", nominal));
+  text.replace(text.find("atol: 1.0e-6}"), 13, "atol: 1.0e-6, nominal_scaling: false}");
+  const RunResult unscaled = run(load_scene(write("unscaled.yaml", text)));
+  const RunResult plain = run(load_scene(decaying("1.0e-6", "")));
+  const RunResult scaled = run(load_scene(decaying("1.0e-6", nominal)));
+  EXPECT_EQ(unscaled.stats.steps, plain.stats.steps);
+  EXPECT_EQ(unscaled.values, plain.values);
+  EXPECT_EQ(unscaled.tangents, plain.tangents);
+  EXPECT_NE(unscaled.stats.steps, scaled.stats.steps);
 }
 
 TEST_F(ErrorControl, SmallerNominalCostsMoreSteps) {
