@@ -1,8 +1,9 @@
 // CVODES (BDF or Adams) with forward sensitivities by the direct method: the sensitivity
 // right-hand side is the diagram's tangent pass, corrected simultaneously with the states and
 // included in the error test or not (solver.sens_error_test); absolute tolerances per state
-// from the blocks' nominal magnitudes (engine/tolerances.hpp); the Newton matrix is the exact Jacobian from tangent passes over
-// the states; objective integrals are quadratures with their own sensitivities.
+// from the blocks' nominal magnitudes (engine/tolerances.hpp); the Newton matrix is the exact
+// Jacobian from tangent passes over the states; objective integrals are quadratures with their
+// own sensitivities. Steps are taken one at a time to count the states that limit them.
 #include "engine/cvodes_solver.hpp"
 
 #include <cvodes/cvodes.h>

@@ -86,7 +86,7 @@ int accuracy_command(const AccuracyArgs& args) {
   verdict << std::setprecision(3);
   if (best)
     verdict << "Cheapest setting for errors below " << args.target << ": " << best->method
-            << (best->method == "bdf" || best->method == "adams" ? " at rtol " : " at step ") << best->setting
+            << (best->method.rfind("bdf", 0) == 0 || best->method.rfind("adams", 0) == 0 ? " at rtol " : " at step ") << best->setting
             << " (" << best->stats.cpu_seconds << " CPU s).";
   else
     verdict << "No setting of the ladder reaches errors below " << args.target << ".";

@@ -119,6 +119,7 @@ int replay_command(const ReplayArgs& args) {
             << r.stats.realtime_factor << "x real time)";
   if (args.realtime) std::cout << ", paced: " << missed << " missed deadlines";
   std::cout << "\n";
+  print_limiting_states(std::cout, r.stats);
   j["validation"] = nlohmann::ordered_json::object();
   for (size_t c = 1; c < recorded.names.size(); ++c) {
     const int i = r.signal_index(recorded.names[c]);
