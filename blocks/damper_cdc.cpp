@@ -186,7 +186,9 @@ class DamperCdc : public Block {
     declare_output("p_compression", 1, "Pa", false);
     declare_output("p_reservoir", 1, "Pa", false);
     declare_output("power", 1, "W", true);
-    declare_states({"p_rebound", "p_compression", "p_reservoir", "q_valve"});
+    // Nominal magnitudes, the peaks of a comfort run: chamber pressures of the order of 1 MPa
+    // (pre-charge 0.5 MPa), valve flow of the annulus area (4.9 cm^2) times 0.2 m/s, 1e-4 m^3/s.
+    declare_states({"p_rebound", "p_compression", "p_reservoir", "q_valve"}, {1e6, 1e6, 1e6, 1e-4});
   }
 
   /// Static equilibrium at zero stroke: every chamber at the gas pre-charge, no flow.

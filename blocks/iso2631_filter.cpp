@@ -55,6 +55,7 @@ class Iso2631Filter : public Block {
     std::vector<std::string> names;
     for (size_t k = 0; k < sections_.size(); ++k)
       for (const char* n : {"xi1_", "xi2_"}) names.push_back(n + std::to_string(k));
+    // The states are scaled like the signal (Section): nominal 1 m/s^2, the default.
     declare_states(names);
   }
 

@@ -63,10 +63,19 @@ class Multibody : public Block {
       declare_output(g_.sensor_ports[s], g_.sensor_widths[s], g_.sensor_units ? g_.sensor_units[s] : "");
       if (!g_.sensor_reads_acceleration[s]) set_output_reads(3 + s, driven_motion);
     }
+    // Nominal magnitudes: a suspension's travel and a body's attitude, 0.01 m or rad, moving at
+    // 0.1 m/s or rad/s (a scene's `nominal:` map sets others, e.g. for a wheel's spin angle).
     std::vector<std::string> states;
-    for (int j : reduced_.independent()) states.push_back(std::string("q.") + g_.coordinate_names[j]);
-    for (int j : reduced_.independent()) states.push_back(std::string("qd.") + g_.coordinate_names[j]);
-    declare_states(states);
+    std::vector<double> nominals;
+    for (int j : reduced_.independent()) {
+      states.push_back(std::string("q.") + g_.coordinate_names[j]);
+      nominals.push_back(0.01);
+    }
+    for (int j : reduced_.independent()) {
+      states.push_back(std::string("qd.") + g_.coordinate_names[j]);
+      nominals.push_back(0.1);
+    }
+    declare_states(states, nominals);
   }
 
   void initial_state(const Eval& e, double* x0) const override {

@@ -81,7 +81,8 @@ class TyreMf : public Block {
     declare_output("mz", 1, "N m", true);
     declare_output("slip_ratio", 1, "", false);
     declare_output("slip_angle", 1, "rad", false);
-    declare_states({"slip_ratio", "slip_angle"});
+    // Nominal magnitudes: 0.1, where the force curves bend (peak slip ratio ~0.1, slip angle ~0.1 rad).
+    declare_states({"slip_ratio", "slip_angle"}, {0.1, 0.1});
   }
 
   void initial_state(const Eval&, double* x0) const override { x0[kKappa] = x0[kAlpha] = 0.0; }

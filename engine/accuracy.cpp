@@ -96,6 +96,11 @@ AccuracyReport accuracy_study(Diagram& d, const AccuracySpec& spec,
       }
     }
   }
+  if (spec.given_setting) {
+    d.solver = saved;
+    const bool cvodes = saved.method == "bdf" || saved.method == "adams";
+    attempt(saved.method + " (given)", cvodes ? saved.rtol : (saved.step > 0 ? saved.step : d.time.output_step / 10));
+  }
   d.solver = saved;
   return report;
 }

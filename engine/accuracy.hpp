@@ -10,7 +10,7 @@
 namespace dydp::engine {
 
 struct AccuracyRow {
-  std::string method;
+  std::string method;         ///< "bdf", ...; "bdf (given)" for the diagram's own setting
   double setting = 0.0;       ///< rtol (CVODES) or step [s] (fixed-step)
   bool ok = false;
   std::string failure;        ///< why the run stopped, when !ok
@@ -33,6 +33,8 @@ struct AccuracySpec {
   std::vector<double> rtols = {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9};
   std::vector<double> step_fractions = {1.0, 0.5, 0.2, 0.1, 0.05, 0.02};  ///< of output_step
   double reference_rtol = 1e-11;
+  /// Also measure the diagram's own solver setting (a row marked `given`), after the ladder.
+  bool given_setting = false;
 };
 
 /// Runs the study on a loaded diagram; its solver settings are changed run by run and restored.

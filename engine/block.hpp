@@ -95,6 +95,12 @@ class Block {
   int num_states() const { return num_states_; }
   int num_quadratures() const { return num_quadratures_; }
   const std::vector<std::string>& state_names() const { return state_names_; }
+  /// Nominal magnitude of each state, in the state's unit: the size of its typical excursion
+  /// (a chamber pressure 1e6 Pa, a wheel travel 0.01 m). The solvers hold state i to the
+  /// absolute tolerance atol * nominal[i], so one atol means the same in every unit. Default 1.
+  const std::vector<double>& state_nominals() const { return state_nominals_; }
+  /// Nominal magnitude of each quadrature (the integral's unit), default 1.
+  const std::vector<double>& quadrature_nominals() const { return quadrature_nominals_; }
 
   /// Initial state x(t0) and its tangent dx(t0) for the parameter seeds in s.p.
   virtual void initial_state(const Eval& e, double* x0) const {}
@@ -168,16 +174,25 @@ class Block {
     outputs_[output].feedthrough = !inputs.empty();
     outputs_[output].reads = std::move(inputs);
   }
-  void declare_states(std::vector<std::string> names) {
+  /// States and their nominal magnitudes (empty: 1 for each).
+  void declare_states(std::vector<std::string> names, std::vector<double> nominals = {}) {
     num_states_ = static_cast<int>(names.size());
     state_names_ = std::move(names);
+    if (nominals.empty()) nominals.assign(state_names_.size(), 1.0);
+    state_nominals_ = std::move(nominals);
   }
-  void declare_quadratures(int n) { num_quadratures_ = n; }
+  void declare_quadratures(int n, std::vector<double> nominals = {}) {
+    num_quadratures_ = n;
+    if (nominals.empty()) nominals.assign(n, 1.0);
+    quadrature_nominals_ = std::move(nominals);
+  }
 
  private:
   std::vector<PortDecl> inputs_;
   std::vector<PortDecl> outputs_;
   std::vector<std::string> state_names_;
+  std::vector<double> state_nominals_;
+  std::vector<double> quadrature_nominals_;
   int num_states_ = 0;
   int num_quadratures_ = 0;
 };

@@ -1,7 +1,9 @@
 // CVODES (BDF or Adams) with forward sensitivities by the direct method: the sensitivity
 // right-hand side is the diagram's tangent pass, corrected simultaneously with the states and
-// included in the error test; the Newton matrix is the exact Jacobian from tangent passes over
-// the states; objective integrals are quadratures with their own sensitivities.
+// included in the error test or not (solver.sens_error_test); absolute tolerances per state
+// from the blocks' nominal magnitudes (engine/tolerances.hpp); the Newton matrix is the exact
+// Jacobian from tangent passes over the states; objective integrals are quadratures with their
+// own sensitivities. Steps are taken one at a time to count the states that limit them.
 #include "engine/cvodes_solver.hpp"
 
 #include <cvodes/cvodes.h>
@@ -18,6 +20,8 @@
 #include "engine/errors.hpp"
 #include "engine/timeline.hpp"
 #include "engine/recorder.hpp"
+#include "engine/step_limiters.hpp"
+#include "engine/tolerances.hpp"
 
 namespace dydp::engine {
 namespace {
@@ -201,7 +205,15 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   check(CVodeSetErrHandlerFn(S.mem, error_handler, &P), "CVodeSetErrHandlerFn");
   check(CVodeInit(S.mem, rhs, t0, S.y), "CVodeInit");
   check(CVodeSetUserData(S.mem, &P), "CVodeSetUserData");
-  check(CVodeSStolerances(S.mem, d.solver.rtol, d.solver.atol), "CVodeSStolerances");
+  // One absolute tolerance per state: atol times its nominal magnitude (a pressure in Pa, a
+  // position in m, a flow in m^3/s each judged in its own units).
+  const AbsoluteTolerances atols = absolute_tolerances(d, d.solver.atol, ns);
+  N_Vector atol_states = N_VClone(S.y);
+  N_VConst(d.solver.atol, atol_states);
+  std::copy_n(atols.states.data(), nx, NV_DATA_S(atol_states));
+  const int sv_flag = CVodeSVtolerances(S.mem, d.solver.rtol, atol_states);
+  N_VDestroy(atol_states);
+  check(sv_flag, "CVodeSVtolerances");
   check(CVodeSetMaxNumSteps(S.mem, d.solver.max_steps), "CVodeSetMaxNumSteps");
   check(CVodeSetMinStep(S.mem, d.solver.min_step), "CVodeSetMinStep");
   if (bdf) {
@@ -214,13 +226,6 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
     check(CVodeSetNonlinearSolver(S.mem, S.NLS), "CVodeSetNonlinearSolver");
   }
 
-  // Sensitivity tolerances scaled by the parameter values (the pbar of CVODES' guide), so
-  // dx/dk for a stiffness of 1e5 N/m is held to the same relative accuracy as dx/dm.
-  std::vector<double> atol_s(ns);
-  for (int dir = 0; dir < ns; ++dir) {
-    const double pv = std::fabs(d.parameters[d.sensitivities[dir]].value);
-    atol_s[dir] = d.solver.atol / (pv > 0 ? pv : 1.0);
-  }
   if (ns > 0) {
     S.ys = N_VCloneVectorArray(ns, S.y);
     std::vector<double> dx0(static_cast<size_t>(nx) * ns, 0.0);
@@ -237,7 +242,16 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
     } else {
       check(CVodeSensInit(S.mem, ns, CV_SIMULTANEOUS, sens_rhs, S.ys), "CVodeSensInit");
     }
-    check(CVodeSensSStolerances(S.mem, d.solver.rtol, atol_s.data()), "CVodeSensSStolerances");
+    // Sensitivity tolerances: the states' ones over the parameter's value (the pbar of CVODES'
+    // guide), so dx/dk for a stiffness of 1e5 N/m is held to the same relative accuracy as dx/dm.
+    N_Vector* atol_sens = N_VCloneVectorArray(ns, S.y);
+    for (int dir = 0; dir < ns; ++dir) {
+      N_VConst(d.solver.atol, atol_sens[dir]);  // the placeholder state of a stateless diagram
+      std::copy_n(atols.sensitivities.data() + static_cast<size_t>(dir) * nx, nx, NV_DATA_S(atol_sens[dir]));
+    }
+    const int ssv_flag = CVodeSensSVtolerances(S.mem, d.solver.rtol, atol_sens);
+    N_VDestroyVectorArray(atol_sens, ns);
+    check(ssv_flag, "CVodeSensSVtolerances");
     check(CVodeSetSensErrCon(S.mem, d.solver.sens_error_test), "CVodeSetSensErrCon");
     if (!bdf) {
       S.NLSsens = SUNNonlinSol_FixedPointSens(ns + 1, S.y, 0, S.ctx);
@@ -248,7 +262,11 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
     S.yq = N_VNew_Serial(nq, S.ctx);
     N_VConst(0.0, S.yq);
     check(CVodeQuadInit(S.mem, quad_rhs, S.yq), "CVodeQuadInit");
-    check(CVodeQuadSStolerances(S.mem, d.solver.rtol, d.solver.atol), "CVodeQuadSStolerances");
+    N_Vector atol_quad = N_VClone(S.yq);
+    std::copy_n(atols.quadratures.data(), nq, NV_DATA_S(atol_quad));
+    const int qsv_flag = CVodeQuadSVtolerances(S.mem, d.solver.rtol, atol_quad);
+    N_VDestroy(atol_quad);
+    check(qsv_flag, "CVodeQuadSVtolerances");
     check(CVodeSetQuadErrCon(S.mem, SUNTRUE), "CVodeSetQuadErrCon");
     if (ns > 0) {
       S.yqs = N_VCloneVectorArray(ns, S.yq);
@@ -257,8 +275,13 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
       // difference-quotient mode: CVODES 6.4's internal quadrature quotients crashed here).
       check(CVodeQuadSensInit(S.mem, quad_sens_rhs, S.yqs),
             "CVodeQuadSensInit");
-      check(CVodeQuadSensSStolerances(S.mem, d.solver.rtol, atol_s.data()),
-            "CVodeQuadSensSStolerances");
+      N_Vector* atol_quad_sens = N_VCloneVectorArray(ns, S.yq);
+      for (int dir = 0; dir < ns; ++dir)
+        std::copy_n(atols.quadrature_sensitivities.data() + static_cast<size_t>(dir) * nq, nq,
+                    NV_DATA_S(atol_quad_sens[dir]));
+      const int qssv_flag = CVodeQuadSensSVtolerances(S.mem, d.solver.rtol, atol_quad_sens);
+      N_VDestroyVectorArray(atol_quad_sens, ns);
+      check(qssv_flag, "CVodeQuadSensSVtolerances");
       check(CVodeSetQuadSensErrCon(S.mem, d.solver.sens_error_test), "CVodeSetQuadSensErrCon");
     }
   }
@@ -280,7 +303,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
     std::vector<double> dx;
     if (ns > 0) {
       sunrealtype tret = t;
-      if (t > t0) check(CVodeGetSens(S.mem, &tret, S.ys), "CVodeGetSens");
+      if (t > t0) check(CVodeGetSensDky(S.mem, tret, 0, S.ys), "CVodeGetSensDky");
       gather(S.ys, nx, ns, dx);
       ev.tangents(t, NV_DATA_S(S.y), ns, {dx.data(), nx}, true, {}, {});
     } else {
@@ -293,56 +316,84 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   const Timeline timeline(d);
   const std::vector<double>& breaks = timeline.breaks;
 
+  // One step at a time, so that after each accepted step the state with the largest weighted
+  // local error is counted (StepLimiters); outputs are interpolated (CVodeGetDky) as CVODES'
+  // normal mode does, from the same steps.
+  StepLimiters limiters(nx);
+  N_Vector local_errors = N_VClone(S.y), weights = N_VClone(S.y);
+  struct Release {
+    N_Vector a, b;
+    ~Release() { N_VDestroy(a), N_VDestroy(b); }
+  } release{local_errors, weights};
+
+  auto fail = [&](int flag, double t, std::string reason) {
+    if (!P.cvodes_message.empty()) reason += " (" + P.cvodes_message + ")";
+    std::string block;
+    // Name the state CVODES could not hold to its tolerance: the largest weighted local error.
+    if (flag == CV_ERR_FAILURE || flag == CV_CONV_FAILURE || flag == CV_TOO_MUCH_WORK) {
+      if (CVodeGetEstLocalErrors(S.mem, local_errors) == CV_SUCCESS &&
+          CVodeGetErrWeights(S.mem, weights) == CV_SUCCESS) {
+        int worst = -1;
+        double largest = -1.0;
+        for (int i = 0; i < nx; ++i) {
+          const double e = std::fabs(NV_Ith_S(local_errors, i) * NV_Ith_S(weights, i));
+          if (e > largest) largest = e, worst = i;
+        }
+        for (const Node& n : d.nodes)
+          if (worst >= n.state_offset && worst < n.state_offset + n.block->num_states()) {
+            block = n.name;
+            reason += "; largest estimated local error in state " +
+                      n.block->state_names()[worst - n.state_offset];
+          }
+      }
+    }
+    if (!P.refusal.empty()) {
+      block = P.refusal.substr(0, P.refusal.find(':'));
+      reason += "; last refused point at t = " + std::to_string(P.refusal_t) + " s: " + P.refusal;
+    }
+    throw SolverError(t, block, reason);
+  };
+
   double t = t0;
+  double reached = t0;  // CVODES' internal time: the end of its last step
   size_t next_break = 0;
   for (double target : timeline.events) {
     while (next_break < breaks.size() && breaks[next_break] < target) ++next_break;
     const double stop = next_break < breaks.size() ? breaks[next_break] : tf;
     check(CVodeSetStopTime(S.mem, stop), "CVodeSetStopTime");
-    const int flag = CVode(S.mem, target, S.y, &t, CV_NORMAL);
-    if (flag < 0) {
-      std::string reason = std::string("CVode failed: ") + CVodeGetReturnFlagName(flag);
-      if (!P.cvodes_message.empty()) reason += " (" + P.cvodes_message + ")";
-      std::string block;
-      // Name the state CVODES could not hold to its tolerance: the largest weighted local error.
-      if (flag == CV_ERR_FAILURE || flag == CV_CONV_FAILURE || flag == CV_TOO_MUCH_WORK) {
-        N_Vector ele = N_VClone(S.y), weights = N_VClone(S.y);
-        if (CVodeGetEstLocalErrors(S.mem, ele) == CV_SUCCESS && CVodeGetErrWeights(S.mem, weights) == CV_SUCCESS) {
-          int worst = -1;
-          double largest = -1.0;
-          for (int i = 0; i < nx; ++i) {
-            const double e = std::fabs(NV_Ith_S(ele, i) * NV_Ith_S(weights, i));
-            if (e > largest) largest = e, worst = i;
-          }
-          for (const Node& n : d.nodes)
-            if (worst >= n.state_offset && worst < n.state_offset + n.block->num_states()) {
-              block = n.name;
-              reason += "; largest estimated local error in state " +
-                        n.block->state_names()[worst - n.state_offset];
-            }
-        }
-        N_VDestroy(ele);
-        N_VDestroy(weights);
-      }
-      if (!P.refusal.empty()) {
-        block = P.refusal.substr(0, P.refusal.find(':'));
-        reason += "; last refused point at t = " + std::to_string(P.refusal_t) + " s: " + P.refusal;
-      }
-      throw SolverError(t, block, reason);
+    long interval_steps = 0;
+    bool at_target = false;  // S.y holds the solution at target (a step ended there)
+    while (reached < target) {
+      if (++interval_steps > d.solver.max_steps)
+        fail(CV_TOO_MUCH_WORK, reached,
+             "CVode failed: CV_TOO_MUCH_WORK (" + std::to_string(d.solver.max_steps) +
+                 " steps taken before reaching the next output time " + format_number(target) + " s)");
+      const int flag = CVode(S.mem, target, S.y, &reached, CV_ONE_STEP);
+      if (flag < 0) fail(flag, reached, std::string("CVode failed: ") + CVodeGetReturnFlagName(flag));
+      if (nx > 0 && CVodeGetEstLocalErrors(S.mem, local_errors) == CV_SUCCESS &&
+          CVodeGetErrWeights(S.mem, weights) == CV_SUCCESS)
+        limiters.add_step(NV_DATA_S(local_errors), NV_DATA_S(weights));
+      at_target = reached == target;
     }
+    // Otherwise the last step went past target, in this interval or an earlier one (it may have
+    // ended exactly on the next output): interpolate.
+    if (!at_target) check(CVodeGetDky(S.mem, target, 0, S.y), "CVodeGetDky");
     t = target;
     if (timeline.is_output(target)) record(target);
     if (next_break < breaks.size() && breaks[next_break] == target && target < tf) {
       accumulate();
       ev.set_segment_start(target);
-      check(CVodeReInit(S.mem, target, S.y), "CVodeReInit");
-      if (ns > 0) {
-        CVodeGetSens(S.mem, &t, S.ys);
-        check(CVodeSensReInit(S.mem, CV_SIMULTANEOUS, S.ys), "CVodeSensReInit");
-      }
+      // The solution at the breakpoint (the last step ended there: it is the stop time) first,
+      // then the restart from it.
+      if (ns > 0) check(CVodeGetSensDky(S.mem, target, 0, S.ys), "CVodeGetSensDky");
       if (nq > 0) {
-        check(CVodeGetQuad(S.mem, &t, S.yq), "CVodeGetQuad");
-        if (ns > 0) check(CVodeGetQuadSens(S.mem, &t, S.yqs), "CVodeGetQuadSens");
+        check(CVodeGetQuadDky(S.mem, target, 0, S.yq), "CVodeGetQuadDky");
+        if (ns > 0) check(CVodeGetQuadSensDky(S.mem, target, 0, S.yqs), "CVodeGetQuadSensDky");
+      }
+      check(CVodeReInit(S.mem, target, S.y), "CVodeReInit");
+      reached = target;
+      if (ns > 0) check(CVodeSensReInit(S.mem, CV_SIMULTANEOUS, S.ys), "CVodeSensReInit");
+      if (nq > 0) {
         check(CVodeQuadReInit(S.mem, S.yq), "CVodeQuadReInit");
         if (ns > 0) check(CVodeQuadSensReInit(S.mem, S.yqs), "CVodeQuadSensReInit");
       }
@@ -351,6 +402,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   }
   accumulate();
   st.sens_rhs_evals = P.sens_passes;
+  st.limiting_states = limiters.ranking(d);
 
   std::vector<double> q(std::max(nq, 1), 0.0), dq(static_cast<size_t>(std::max(nq, 1)) * ns, 0.0);
   if (nq > 0) {

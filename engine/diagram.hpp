@@ -33,6 +33,9 @@ struct SolverSpec {
   /// CVODES: include the sensitivities (and quadrature sensitivities) in the error test.
   /// Off, the steps are chosen for the states alone: cheaper, sensitivities less controlled.
   bool sens_error_test = true;
+  /// Absolute tolerances scaled by the states' nominal magnitudes (atol * nominal_i); false:
+  /// atol as it stands for every state, the nominal magnitudes ignored.
+  bool nominal_scaling = true;
 };
 
 struct SceneParameter {
@@ -57,6 +60,9 @@ struct Node {
   std::vector<double> p;            ///< parameter values, ParamSpec order
   std::vector<int> p_scene;         ///< scene parameter driving p[j], or -1
   std::vector<int> p_line;          ///< where p[j] was written (0: default)
+  /// Nominal magnitude of each state (the block's, with the scene's `nominal:` entries);
+  /// empty for nodes not read from a scene: the block's declared values.
+  std::vector<double> state_nominal;
   std::vector<int> input_source;    ///< signal offset of the output feeding input k
   std::vector<int> output_offset;   ///< signal offset of output k
   int state_offset = 0;

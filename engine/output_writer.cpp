@@ -65,6 +65,10 @@ std::string run_json(const Diagram& d, const RunResult& r) {
   const RunStats& s = r.stats;
   nlohmann::ordered_json parameters = nlohmann::ordered_json::object();
   for (const auto& p : d.parameters) parameters[p.name] = {{"value", p.value}, {"unit", p.unit}};
+  // Per state: the share of the accepted steps at which it had the largest weighted local error.
+  nlohmann::ordered_json limiting = nlohmann::ordered_json::array();
+  for (const LimitingState& l : s.limiting_states)
+    limiting.push_back({{"state", l.state}, {"steps", l.steps}, {"share", l.share}});
   nlohmann::ordered_json j = {
       {"scene", d.scene_name},
       {"file", d.file},
@@ -73,6 +77,7 @@ std::string run_json(const Diagram& d, const RunResult& r) {
       {"atol", s.atol},
       {"fixed_step", s.step},
       {"sens_error_test", d.solver.sens_error_test},
+      {"nominal_scaling", d.solver.nominal_scaling},
       {"parameters", parameters},
       {"sensitivities", r.sensitivity_names},
       {"states", d.num_states},
@@ -84,6 +89,7 @@ std::string run_json(const Diagram& d, const RunResult& r) {
       {"error_test_failures", s.error_test_failures},
       {"nonlinear_iterations", s.nonlinear_iterations},
       {"nonlinear_failures", s.nonlinear_failures},
+      {"limiting_states", limiting},
       {"cpu_seconds", s.cpu_seconds},
       {"simulated_seconds", s.simulated_seconds},
       {"realtime_factor", s.realtime_factor},

@@ -23,6 +23,13 @@ struct RunOptions {
   std::function<void(const RunResult&)> on_sample;
 };
 
+/// A state that limited the step size (see engine/step_limiters.hpp).
+struct LimitingState {
+  std::string state;   ///< block.state
+  long steps = 0;      ///< accepted steps at which its weighted local error was the largest
+  double share = 0.0;  ///< steps / all counted steps
+};
+
 struct RunStats {
   std::string method;
   double rtol = 0.0, atol = 0.0, step = 0.0;
@@ -38,6 +45,8 @@ struct RunStats {
   double simulated_seconds = 0.0;
   double realtime_factor = 0.0;   ///< simulated seconds per CPU second
   std::vector<std::string> warnings;
+  /// Variable-step solvers: the states that limited the step most often, most often first.
+  std::vector<LimitingState> limiting_states;
 };
 
 struct ObjectiveResult {

@@ -14,6 +14,7 @@
 #include "engine/duplicate_keys.hpp"
 #include "engine/errors.hpp"
 #include "engine/graph_builder.hpp"
+#include "engine/nominal_overrides.hpp"
 #include "engine/scene_relations.hpp"
 
 namespace dydp::engine {
@@ -90,7 +91,7 @@ void read_time(const SceneReader& r, const YAML::Node& n, TimeSpec& time) {
 
 void read_solver(const SceneReader& r, const YAML::Node& n, const TimeSpec& time, SolverSpec& s) {
   if (!n) return check_solver_relations(r.file(), n, s, time);
-  r.allow_keys(n, "solver", {"method", "rtol", "atol", "step", "max_steps", "min_step", "sens_error_test"});
+  r.allow_keys(n, "solver", {"method", "rtol", "atol", "step", "max_steps", "min_step", "sens_error_test", "nominal_scaling"});
   if (n["method"]) {
     s.method = r.text(n["method"], "solver.method");
     if (s.method != "bdf" && s.method != "adams" && s.method != "rk4" && s.method != "sdirk2")
@@ -103,6 +104,11 @@ void read_solver(const SceneReader& r, const YAML::Node& n, const TimeSpec& time
     const std::string v = r.text(e, "solver.sens_error_test");
     if (v != "true" && v != "false") r.fail(e, "solver.sens_error_test", "expected true or false");
     s.sens_error_test = v == "true";
+  }
+  if (const YAML::Node e = n["nominal_scaling"]) {
+    const std::string v = r.text(e, "solver.nominal_scaling");
+    if (v != "true" && v != "false") r.fail(e, "solver.nominal_scaling", "expected true or false");
+    s.nominal_scaling = v == "true";
   }
   if (n["max_steps"]) {
     const double v = r.number(n["max_steps"], "solver.max_steps");
@@ -172,7 +178,7 @@ Node read_block(const SceneReader& r, const YAML::Node& key, const YAML::Node& b
   for (auto kv : body) {
     const std::string k = kv.first.Scalar();
     const std::string field = node.name + "." + k;
-    if (k == "type") continue;
+    if (k == "type" || k == "nominal") continue;
     seen.insert(k);
     auto ps = std::find_if(type.parameters.begin(), type.parameters.end(),
                            [&](const ParamSpec& s) { return s.name == k; });
@@ -235,6 +241,9 @@ Node read_block(const SceneReader& r, const YAML::Node& key, const YAML::Node& b
     node.p_line.push_back(line);
   }
   node.block = type.make(settings);
+  node.state_nominal = body["nominal"]
+                           ? read_nominal_overrides(r.file(), node.name, body["nominal"], *node.block)
+                           : node.block->state_nominals();
   node.objective = dynamic_cast<const Objective*>(node.block.get());
   node.settings = std::make_shared<const BlockSettings>(std::move(settings));
   check_block(r.file(), node, node.p, d.time, &warnings);

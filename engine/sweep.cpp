@@ -11,9 +11,16 @@
 namespace dydp::engine {
 namespace {
 
+/// The scene with the spec's parameter and solver overrides.
+Diagram load(const SweepSpec& spec) {
+  Diagram d = load_scene(spec.scene, spec.overrides);
+  apply_solver_overrides(d, spec.solver);
+  return d;
+}
+
 /// psi of every objective for the scene at parameter value p, without sensitivities.
 std::vector<double> objectives_at(const SweepSpec& spec, int index, double p) {
-  Diagram d = load_scene(spec.scene, spec.overrides);
+  Diagram d = load(spec);
   d.set_parameter(index, p, /*check_range=*/false);
   RunOptions o;
   o.sensitivities = false;
@@ -26,7 +33,7 @@ std::vector<double> objectives_at(const SweepSpec& spec, int index, double p) {
 
 SweepResult sweep(const SweepSpec& spec) {
   // Validate once, up front, so that a bad spec fails before any thread starts.
-  Diagram probe = load_scene(spec.scene, spec.overrides);
+  Diagram probe = load(spec);
   const int index = probe.find_parameter(spec.parameter);
   if (index < 0) throw InputError("--param", 0, spec.parameter, "no scene parameter of that name in " + spec.scene);
   if (spec.points < 1) throw InputError("--range", 0, "N", "needs at least one point");
@@ -57,7 +64,7 @@ SweepResult sweep(const SweepSpec& spec) {
     for (int k = next++; k < spec.points; k = next++) {
       try {
         SweepPoint& pt = result.points[k];
-        Diagram d = load_scene(spec.scene, spec.overrides);
+        Diagram d = load(spec);
         d.set_parameter(index, pt.p);
         // The swept parameter is the one sensitivity direction the sweep needs.
         d.sensitivities = {index};

@@ -7,12 +7,14 @@
 #include <vector>
 
 #include "engine/run.hpp"
+#include "engine/solver_overrides.hpp"
 
 namespace dydp::engine {
 
 struct SweepSpec {
   std::string scene;
   std::vector<std::pair<std::string, std::string>> overrides;
+  SolverOverrides solver;        ///< --solver, --rtol, --atol, --step
   std::string parameter;
   double low = 0.0, high = 1.0;
   int points = 5;

@@ -40,6 +40,11 @@ int blocks_command(std::ostream& out) {
     for (const auto& p : block->outputs())
       out << "    output  " << std::left << std::setw(12) << p.name << " width " << p.width
           << (p.unit.empty() ? "" : " [" + p.unit + "]") << "\n";
+    // The nominal magnitudes scale the absolute tolerance of each state (a scene's `nominal:`
+    // map overrides them).
+    for (int i = 0; i < block->num_states(); ++i)
+      out << "    state   " << std::left << std::setw(12) << block->state_names()[i] << " nominal "
+          << block->state_nominals()[i] << "\n";
   }
   return 0;
 }

@@ -5,10 +5,14 @@
 #include <string>
 #include <vector>
 
+#include "engine/run.hpp"
+#include "engine/solver_overrides.hpp"
+
 namespace dydp::apps {
 
 struct RunArgs {
   std::string scene;
+  engine::SolverOverrides solver;  ///< --solver, --rtol, --atol, --step
   std::string out = "out";
   std::vector<std::string> sets;  ///< NAME=VALUE
   bool no_sens = false;
@@ -17,6 +21,7 @@ struct RunArgs {
 
 struct SweepArgs {
   std::string scene;
+  engine::SolverOverrides solver;  ///< --solver, --rtol, --atol, --step
   std::string out = "out";
   std::vector<std::string> sets;
   std::string parameter;
@@ -28,14 +33,17 @@ struct SweepArgs {
 
 struct AccuracyArgs {
   std::string scene;
+  engine::SolverOverrides solver;  ///< --solver, --rtol, --atol, --step
   std::string out = "out";
   std::vector<std::string> sets;
   double target = 1e-4;  ///< requested relative accuracy for the "cheapest setting" line
   std::vector<std::string> methods = {"bdf", "adams", "rk4", "sdirk2"};
+  bool methods_given = false;  ///< --methods written (with solver overrides: no ladder unless)
 };
 
 struct ReplayArgs {
   std::string scene;
+  engine::SolverOverrides solver;  ///< --solver, --rtol, --atol, --step
   std::string input;              ///< recorded CSV: t, one column per pad, measured responses
   std::string out = "out";
   std::vector<std::string> sets;
@@ -51,6 +59,9 @@ int blocks_command(std::ostream& out);
 
 /// Prints the scene's load-time warnings to stderr ("warning: file:line: field: message").
 void print_warnings(const std::vector<std::string>& warnings);
+
+/// "  step limited by: car.qd.z 41 %, damper_fl.q_valve 12 %, ..." (nothing for fixed-step runs).
+void print_limiting_states(std::ostream& out, const engine::RunStats& stats);
 
 /// Splits NAME=VALUE pairs; throws InputError naming --set on a malformed one.
 std::vector<std::pair<std::string, std::string>> parse_sets(const std::vector<std::string>& sets);

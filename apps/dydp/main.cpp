@@ -9,6 +9,19 @@
 #include "apps/dydp/commands.hpp"
 #include "engine/errors.hpp"
 
+namespace {
+
+/// --solver, --rtol, --atol, --step over the scene's solver section.
+void add_solver_options(CLI::App* command, dydp::engine::SolverOverrides& o) {
+  command->add_option("--solver", o.method, "integrator instead of the scene's (bdf adams rk4 sdirk2)");
+  command->add_option_function<double>("--rtol", [&o](const double& v) { o.rtol = v; }, "relative tolerance");
+  command->add_option_function<double>(
+      "--atol", [&o](const double& v) { o.atol = v; }, "absolute tolerance, times each state's nominal magnitude");
+  command->add_option_function<double>("--step", [&o](const double& v) { o.step = v; }, "fixed step [s]");
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"dydp: exact sensitivities of vehicle comfort and handling to design parameters"};
   app.require_subcommand(1);
@@ -20,6 +33,7 @@ int main(int argc, char** argv) {
   run->add_option("--set", run_args.sets, "override a scene parameter: NAME=VALUE");
   run->add_flag("--no-sens", run_args.no_sens, "run without sensitivities");
   run->add_flag("--report", run_args.report, "also write plots (gnuplot) and report.md");
+  add_solver_options(run, run_args.solver);
 
   dydp::apps::SweepArgs sweep_args;
   CLI::App* sweep = app.add_subcommand("sweep", "psi and d(psi)/dp over a range of one parameter");
@@ -31,6 +45,7 @@ int main(int argc, char** argv) {
   sweep->add_option("--fd", sweep_args.fd_steps, "central differences at these absolute steps")->delimiter(',');
   sweep->add_option("--delta", sweep_args.delta, "report the change of psi for this step of the parameter");
   sweep->add_flag("--report", sweep_args.report, "also write plots (gnuplot) and report.md");
+  add_solver_options(sweep, sweep_args.solver);
 
   dydp::apps::AccuracyArgs accuracy_args;
   CLI::App* accuracy = app.add_subcommand("accuracy", "Error against run time over solvers and tolerances");
@@ -42,6 +57,7 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->check(CLI::IsMember({"bdf", "adams", "rk4", "sdirk2"}))
       ->capture_default_str();
+  add_solver_options(accuracy, accuracy_args.solver);
 
   dydp::apps::ReplayArgs replay_args;
   CLI::App* replay = app.add_subcommand("replay", "Replay recorded test-bench input through a scene");
@@ -51,6 +67,7 @@ int main(int argc, char** argv) {
   replay->add_option("--set", replay_args.sets, "override a scene parameter: NAME=VALUE");
   replay->add_flag("--realtime", replay_args.realtime, "pace the run to the wall clock and report missed deadlines");
   replay->add_flag("--no-sens", replay_args.no_sens, "run without sensitivities");
+  add_solver_options(replay, replay_args.solver);
 
   CLI::App* blocks = app.add_subcommand("blocks", "List the block types with ports and parameters");
 
@@ -64,6 +81,7 @@ int main(int argc, char** argv) {
   try {
     if (*run) return dydp::apps::run_command(run_args);
     if (*sweep) return dydp::apps::sweep_command(sweep_args);
+    accuracy_args.methods_given = accuracy->count("--methods") > 0;
     if (*accuracy) return dydp::apps::accuracy_command(accuracy_args);
     if (*replay) return dydp::apps::replay_command(replay_args);
     if (*blocks) return dydp::apps::blocks_command(std::cout);

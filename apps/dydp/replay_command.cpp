@@ -74,6 +74,7 @@ int replay_command(const ReplayArgs& args) {
     throw engine::InputError(args.input, 1, "t", "the first column must be the time t [s]");
   const std::string input = std::filesystem::absolute(args.input).string();
   engine::Diagram d = engine::load_scene(args.scene, parse_sets(args.sets), {{"input_file", input}});
+  engine::apply_solver_overrides(d, args.solver);
   bool takes_input = false;
   for (const auto& n : d.nodes)
     for (const auto& s : n.type->settings) takes_input = takes_input || s.name == "input_file";
@@ -118,6 +119,7 @@ int replay_command(const ReplayArgs& args) {
             << r.stats.realtime_factor << "x real time)";
   if (args.realtime) std::cout << ", paced: " << missed << " missed deadlines";
   std::cout << "\n";
+  print_limiting_states(std::cout, r.stats);
   j["validation"] = nlohmann::ordered_json::object();
   for (size_t c = 1; c < recorded.names.size(); ++c) {
     const int i = r.signal_index(recorded.names[c]);

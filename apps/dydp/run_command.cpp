@@ -24,12 +24,24 @@ std::vector<std::pair<std::string, std::string>> parse_sets(const std::vector<st
   return out;
 }
 
+void print_limiting_states(std::ostream& out, const engine::RunStats& stats) {
+  if (stats.limiting_states.empty()) return;
+  out << "  step limited by:";
+  const char* separator = " ";
+  for (const engine::LimitingState& l : stats.limiting_states) {
+    out << separator << l.state << " " << std::fixed << std::setprecision(0) << 100 * l.share << " %";
+    separator = ", ";
+  }
+  out << std::defaultfloat << "\n";
+}
+
 void print_warnings(const std::vector<std::string>& warnings) {
   for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
 }
 
 int run_command(const RunArgs& args) {
   engine::Diagram d = engine::load_scene(args.scene, parse_sets(args.sets));
+  engine::apply_solver_overrides(d, args.solver);
   print_warnings(d.warnings);
 
   engine::RunOptions options;
@@ -53,6 +65,7 @@ int run_command(const RunArgs& args) {
             << std::setprecision(3) << r.stats.cpu_seconds << " CPU s for "
             << r.stats.simulated_seconds << " s simulated (" << std::setprecision(4)
             << r.stats.realtime_factor << "x real time)\n";
+  print_limiting_states(std::cout, r.stats);
   for (const auto& o : r.objectives) {
     std::cout << "  " << o.name << " = " << std::setprecision(6) << o.value << (o.unit.empty() ? "" : " " + o.unit);
     for (size_t k = 0; k < o.sensitivity.size(); ++k) {

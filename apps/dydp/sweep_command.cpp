@@ -63,6 +63,7 @@ int sweep_command(const SweepArgs& args) {
   engine::SweepSpec spec;
   spec.scene = args.scene;
   spec.overrides = parse_sets(args.sets);
+  spec.solver = args.solver;
   spec.parameter = args.parameter;
   parse_range(args.range, spec);
   spec.fd_steps = args.fd_steps;

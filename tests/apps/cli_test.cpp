@@ -302,6 +302,23 @@ TEST_F(Cli, RunJsonKeys) {
   EXPECT_TRUE(j["warnings"].is_array());
   ASSERT_TRUE(j.contains("parameters"));
   EXPECT_DOUBLE_EQ(j["parameters"]["mass"]["value"].get<double>(), 1.5);
+  // The states that limited the step: both of the body's, every accepted step counted once
+  // (against CVODES' own step count), most often first, and the first named on stdout.
+  ASSERT_TRUE(j["limiting_states"].is_array());
+  ASSERT_EQ(j["limiting_states"].size(), 2u) << j["limiting_states"].dump();
+  long counted = 0;
+  double shares = 0.0;
+  for (const auto& l : j["limiting_states"]) {
+    const std::string state = l["state"].get<std::string>();
+    EXPECT_TRUE(state == "body.x" || state == "body.v") << state;
+    counted += l["steps"].get<long>();
+    shares += l["share"].get<double>();
+  }
+  EXPECT_EQ(counted, j["steps"].get<long>());
+  EXPECT_NEAR(shares, 1.0, 1e-12);
+  EXPECT_GE(j["limiting_states"][0]["steps"].get<long>(), j["limiting_states"][1]["steps"].get<long>());
+  EXPECT_NE(r.out.find("step limited by: " + j["limiting_states"][0]["state"].get<std::string>()), std::string::npos)
+      << r.out;
 }
 
 TEST_F(Cli, SetChangesTheObjectiveAndRunJson) {

@@ -1,0 +1,39 @@
+#include "engine/solver_overrides.hpp"
+
+#include <cmath>
+
+#include "engine/errors.hpp"
+#include "engine/scene_relations.hpp"
+
+namespace dydp::engine {
+
+void apply_solver_overrides(Diagram& d, const SolverOverrides& o) {
+  const auto fail = [](const char* option, const std::string& message) {
+    throw InputError(option, 0, "", message);
+  };
+  if (!o.method.empty()) {
+    if (o.method != "bdf" && o.method != "adams" && o.method != "rk4" && o.method != "sdirk2")
+      fail("--solver", "unknown method '" + o.method + "' (bdf, adams, rk4, sdirk2)");
+    d.solver.method = o.method;
+  }
+  if (o.rtol) {
+    if (!(*o.rtol > 0 && *o.rtol < 1)) fail("--rtol", "value " + format_number(*o.rtol) + " must be in (0, 1)");
+    d.solver.rtol = *o.rtol;
+  }
+  if (o.atol) {
+    if (!(*o.atol > 0 && *o.atol < 1))
+      fail("--atol", "value " + format_number(*o.atol) +
+                         " must be in (0, 1) (it multiplies each state's nominal magnitude)");
+    d.solver.atol = *o.atol;
+  }
+  if (o.step) {
+    const double span = d.time.stop - d.time.start;
+    if (!(*o.step > 0)) fail("--step", "value " + format_number(*o.step) + " must be positive");
+    if (!(span / *o.step <= kMaxFixedSteps))
+      fail("--step", "gives " + format_number(span / *o.step) + " steps, more than " +
+                         format_number(kMaxFixedSteps));
+    d.solver.step = *o.step;
+  }
+}
+
+}  // namespace dydp::engine

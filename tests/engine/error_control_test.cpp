@@ -1,0 +1,225 @@
+// Physical error control: the absolute tolerance of each state is atol times its nominal
+// magnitude (declared by the block, overridden by a scene's `nominal:` map), and the run
+// reports which states limited the step.
+//
+// The checks rest on what the tolerance vector must do, not on recorded step counts: a run
+// with nominal s and atol a holds every state to a * s, exactly as a run with nominal 1 and
+// atol a * s does (the two must take the same steps and give the same numbers); a smaller
+// nominal is a tighter tolerance and must cost more steps; and of two uncoupled oscillators,
+// the fast one sets the step until the slow one's tolerance is made far tighter.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "engine/diagram.hpp"
+#include "engine/errors.hpp"
+#include "engine/output_writer.hpp"
+#include "engine/run.hpp"
+#include "engine/tolerances.hpp"
+#include "tests/temp_folder_test.hpp"
+
+namespace dydp::engine {
+namespace {
+
+class ErrorControl : public test::TempFolderTest {
+ protected:
+  ErrorControl() : TempFolderTest("dydp_error_control_") {}
+
+  /// A damped oscillator released from x0 = 1 mm, decaying over 10 s, so that the absolute
+  /// tolerance (not rtol) decides the steps once it has decayed; sensitivity to k.
+  std::string decaying(const std::string& atol, const std::string& nominal) {
+    return write("decay.yaml",
+                 "scene: decay\n"
+                 "time: {stop: 10.0, output_step: 0.1}\n"
+                 "solver: {method: bdf, rtol: 1.0e-4, atol: " + atol + "}\n"
+                 "parameters:\n"
+                 "  k: {value: 400.0}\n"
+                 "sensitivities: [k]\n"
+                 "blocks:\n"
+                 "  zero: {type: source.constant, value: 0.0}\n"
+                 "  m: {type: mass_spring_damper, m: 1.0, k: $k, c: 4.0, x0: 1.0e-3" +
+                     (nominal.empty() ? "" : ", nominal: " + nominal) + "}\n"
+                 "connections:\n"
+                 "  - zero.y -> m.f\n"
+                 "outputs: [m.x]\n");
+  }
+
+  /// Two uncoupled oscillators, 1 rad/s and 3 rad/s, of equal amplitude, with rtol so small that
+  /// the absolute tolerances alone set the step: at equal tolerances the fast one's local error
+  /// (of the order of omega^(q+1) at order q) is the larger, by 3^(q+1) <= 729 up to order 5.
+  std::string two_oscillators(const std::string& slow_nominal) {
+    return write("two.yaml",
+                 "scene: two\n"
+                 "time: {stop: 5.0, output_step: 0.05}\n"
+                 "solver: {method: bdf, rtol: 1.0e-13, atol: 1.0e-6}\n"
+                 "blocks:\n"
+                 "  zero: {type: source.constant, value: 0.0}\n"
+                 "  slow: {type: mass_spring_damper, m: 1.0, k: 1.0, x0: 1.0" +
+                     (slow_nominal.empty() ? "" : ", nominal: " + slow_nominal) + "}\n"
+                 "  fast: {type: mass_spring_damper, m: 1.0, k: 9.0, x0: 1.0}\n"
+                 "connections:\n"
+                 "  - zero.y -> slow.f\n"
+                 "  - zero.y -> fast.f\n"
+                 "outputs: [slow.x, fast.x]\n");
+  }
+
+  static std::string read(const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }
+
+  static double share_of(const RunStats& s, const std::string& block) {
+    double share = 0.0;
+    for (const LimitingState& l : s.limiting_states)
+      if (l.state.rfind(block + ".", 0) == 0) share += l.share;
+    return share;
+  }
+};
+
+TEST_F(ErrorControl, BlocksDeclareNominalsAndScenesOverrideThem) {
+  const Diagram d = load_scene(write("n.yaml",
+                                     "scene: n\n"
+                                     "time: {stop: 1.0, output_step: 0.1}\n"
+                                     "blocks:\n"
+                                     "  zero: {type: source.constant, value: 0.0}\n"
+                                     "  damper: {type: damper.cdc, nominal: {q_valve: 2.0e-4}}\n"
+                                     "  m: {type: mass_spring_damper, nominal: {v: 0.5}}\n"
+                                     "connections:\n"
+                                     "  - zero.y -> damper.stroke\n"
+                                     "  - zero.y -> damper.stroke_rate\n"
+                                     "  - damper.force -> m.f\n"
+                                     "outputs: [m.x]\n"));
+  const std::vector<double> nominal = state_nominals(d);
+  ASSERT_EQ(nominal.size(), 6u);
+  // damper: the three pressures as declared (1 MPa), the flow overridden; m: x by default (1).
+  for (const Node& n : d.nodes) {
+    if (n.name == "damper") {
+      EXPECT_EQ(nominal[n.state_offset + 0], 1e6);
+      EXPECT_EQ(nominal[n.state_offset + 2], 1e6);
+      EXPECT_EQ(nominal[n.state_offset + 3], 2e-4);
+      EXPECT_EQ(state_label(d, n.state_offset + 3), "damper.q_valve");
+    }
+    if (n.name == "m") {
+      EXPECT_EQ(nominal[n.state_offset + 0], 1.0);
+      EXPECT_EQ(nominal[n.state_offset + 1], 0.5);
+    }
+  }
+  const AbsoluteTolerances t = absolute_tolerances(d, 1e-8, 0);
+  for (int i = 0; i < d.num_states; ++i) EXPECT_DOUBLE_EQ(t.states[i], 1e-8 * nominal[i]);
+}
+
+TEST_F(ErrorControl, NominalTimesAtolIsTheToleranceCvodesGets) {
+  // nominal 2^-10 with atol 1e-6 must be the run with nominal 1 and atol 1e-6 / 1024: same
+  // steps, same values, same sensitivities (their tolerance, atol * nominal / |k|, the same too).
+  // A power of two, so that atol * nominal is the double nearest to 9.765625e-10 as written.
+  RunResult scaled = run(load_scene(decaying("1.0e-6", "{x: 0.0009765625, v: 0.0009765625}")));
+  RunResult plain = run(load_scene(decaying("9.765625e-10", "")));
+  EXPECT_GT(scaled.stats.steps, run(load_scene(decaying("1.0e-6", ""))).stats.steps);
+  EXPECT_EQ(scaled.stats.steps, plain.stats.steps);
+  ASSERT_EQ(scaled.values.size(), plain.values.size());
+  for (size_t i = 0; i < plain.values.size(); ++i) EXPECT_EQ(scaled.values[i], plain.values[i]);
+  for (size_t i = 0; i < plain.tangents.size(); ++i) EXPECT_EQ(scaled.tangents[i], plain.tangents[i]);
+}
+
+TEST_F(ErrorControl, WithoutNominalScalingAtolHoldsEveryStateAsItStands) {
+  // nominal_scaling: false ignores the nominals: the run with nominal 2^-10 is then the run with
+  // nominal 1, and it is not the scaled one.
+  const std::string nominal = "{x: 0.0009765625, v: 0.0009765625}";
+  std::string text = read(decaying("1.0e-6", nominal));
+  text.replace(text.find("atol: 1.0e-6}"), 13, "atol: 1.0e-6, nominal_scaling: false}");
+  const RunResult unscaled = run(load_scene(write("unscaled.yaml", text)));
+  const RunResult plain = run(load_scene(decaying("1.0e-6", "")));
+  const RunResult scaled = run(load_scene(decaying("1.0e-6", nominal)));
+  EXPECT_EQ(unscaled.stats.steps, plain.stats.steps);
+  EXPECT_EQ(unscaled.values, plain.values);
+  EXPECT_EQ(unscaled.tangents, plain.tangents);
+  EXPECT_NE(unscaled.stats.steps, scaled.stats.steps);
+}
+
+TEST_F(ErrorControl, SmallerNominalCostsMoreSteps) {
+  const long loose = run(load_scene(decaying("1.0e-6", ""))).stats.steps;
+  const long tight = run(load_scene(decaying("1.0e-6", "{x: 1.0e-3, v: 1.0e-2}"))).stats.steps;
+  const long tighter = run(load_scene(decaying("1.0e-6", "{x: 1.0e-5, v: 1.0e-4}"))).stats.steps;
+  EXPECT_LT(loose, tight);
+  EXPECT_LT(tight, tighter);
+}
+
+TEST_F(ErrorControl, TheFastOscillatorLimitsTheStepUntilTheSlowOneIsHeldTighter) {
+  const RunResult both = run(load_scene(two_oscillators("")));
+  ASSERT_FALSE(both.stats.limiting_states.empty());
+  EXPECT_EQ(both.stats.limiting_states[0].state.rfind("fast.", 0), 0u) << both.stats.limiting_states[0].state;
+  EXPECT_GT(share_of(both.stats, "fast"), 0.9);
+  double total = 0.0;
+  long steps = 0;
+  for (const LimitingState& l : both.stats.limiting_states) total += l.share, steps += l.steps;
+  EXPECT_LE(total, 1.0 + 1e-12);
+  EXPECT_LE(steps, both.stats.steps);
+
+  // Held to a tolerance 1e5 times tighter (more than 729), the slow oscillator's error is the
+  // one the step is chosen for, and the steps are more.
+  const RunResult strict = run(load_scene(two_oscillators("{x: 1.0e-5, v: 1.0e-5}")));
+  EXPECT_GT(strict.stats.steps, both.stats.steps);
+  EXPECT_EQ(strict.stats.limiting_states[0].state.rfind("slow.", 0), 0u) << strict.stats.limiting_states[0].state;
+  EXPECT_GT(share_of(strict.stats, "slow"), 0.9);
+
+  // run.json names them, block.state and share.
+  const std::string json = run_json(load_scene(two_oscillators("")), both);
+  EXPECT_NE(json.find("\"limiting_states\""), std::string::npos);
+  EXPECT_NE(json.find("\"state\": \"" + both.stats.limiting_states[0].state + "\""), std::string::npos);
+}
+
+TEST_F(ErrorControl, BadNominalsAreRefusedWithFileLineAndField) {
+  auto expect_refused = [&](const std::string& nominal, const std::string& field, const std::string& phrase) {
+    const std::string path = write("bad.yaml",
+                                   "scene: bad\n"
+                                   "time: {stop: 1.0, output_step: 0.1}\n"
+                                   "blocks:\n"
+                                   "  zero: {type: source.constant, value: 0.0}\n"
+                                   "  m:\n"
+                                   "    type: mass_spring_damper\n"
+                                   "    nominal: " + nominal + "\n"
+                                   "connections:\n"
+                                   "  - zero.y -> m.f\n"
+                                   "outputs: [m.x]\n");
+    try {
+      load_scene(path);
+      ADD_FAILURE() << nominal << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.file(), path);
+      EXPECT_EQ(e.line(), 7) << e.what();
+      EXPECT_EQ(e.field(), field) << e.what();
+      EXPECT_NE(std::string(e.what()).find(phrase), std::string::npos) << e.what();
+    }
+  };
+  expect_refused("{y: 1.0}", "m.nominal.y", "no state of that name (states: x v)");
+  expect_refused("{x: 0.0}", "m.nominal.x", "must be positive");
+  expect_refused("{x: -1.0}", "m.nominal.x", "must be positive");
+  expect_refused("{x: .inf}", "m.nominal.x", "expected a number");
+  expect_refused("{x: big}", "m.nominal.x", "expected a number");
+  expect_refused("1.0", "m.nominal", "expected a mapping");
+}
+
+TEST_F(ErrorControl, ABlockWithoutStatesHasNoNominalsToSet) {
+  const std::string path = write("stateless.yaml",
+                                 "scene: s\n"
+                                 "time: {stop: 1.0, output_step: 0.1}\n"
+                                 "blocks:\n"
+                                 "  zero: {type: source.constant, value: 0.0, nominal: {x: 1.0}}\n"
+                                 "  m: {type: mass_spring_damper}\n"
+                                 "connections:\n"
+                                 "  - zero.y -> m.f\n"
+                                 "outputs: [m.x]\n");
+  try {
+    load_scene(path);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), 4);
+    EXPECT_EQ(e.field(), "zero.nominal.x");
+    EXPECT_NE(std::string(e.what()).find("has no states"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace dydp::engine
