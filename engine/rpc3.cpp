@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -65,10 +66,12 @@ void put_record(std::string& out, const std::string& key, const std::string& val
   out.append(record, kRecord);
 }
 
+/// The shortest text that reads back as the same double (a reader gets DELTA_T and the
+/// scales exactly).
 std::string number_text(double v) {
   char text[32];
-  std::snprintf(text, sizeof text, "%.9g", v);
-  return text;
+  const auto end = std::to_chars(text, text + sizeof text, v).ptr;
+  return std::string(text, end);
 }
 
 }  // namespace

@@ -102,7 +102,14 @@ RunArrays run_scene(const Scene& scene, bool sensitivities, const py::object& pr
 std::unique_ptr<Scene> load(const std::string& path, const py::dict& overrides) {
   const auto sets = overrides_from(overrides);
   py::gil_scoped_release released;
-  return std::make_unique<Scene>(Scene{engine::load_scene(path, sets)});
+  try {
+    return std::make_unique<Scene>(Scene{engine::load_scene(path, sets)});
+  } catch (const engine::InputError& e) {
+    // The loader names an override by its command-line option; here it came from `overrides`.
+    const std::string option = "--set: " + e.field() + ": ", what = e.what();
+    if (e.file() != "--set" || what.rfind(option, 0) != 0) throw;
+    throw engine::InputError("overrides", e.line(), e.field(), what.substr(option.size()));
+  }
 }
 
 py::dict parameters_of(const engine::Diagram& d) {

@@ -26,14 +26,18 @@ def test_a_bad_block_parameter_names_file_line_and_field(tmp_path, short_msd):
 def test_an_unknown_override_is_refused(short_msd):
     with pytest.raises(dydp.InputError) as caught:
         dydp.load(short_msd, {"no_such_parameter": 1.0})
-    assert caught.value.field != "" or "no_such_parameter" in str(caught.value)
-    assert "no_such_parameter" in str(caught.value)
+    e = caught.value
+    assert (e.file, e.line, e.field) == ("overrides", 0, "no_such_parameter")
+    assert str(e).startswith("overrides: no_such_parameter: no scene parameter of that name"), str(e)
 
 
 def test_an_override_out_of_range_is_refused(short_msd):
     with pytest.raises(dydp.InputError) as caught:
         dydp.load(short_msd, {"stiffness": 5000.0})
-    assert "stiffness" in str(caught.value)
+    # The range is written in the scene: the error points there.
+    assert caught.value.file == short_msd and caught.value.field == "parameters.stiffness"
+    assert caught.value.line == 9
+    assert "outside its range" in str(caught.value)
 
 
 def test_a_missing_scene_file(tmp_path):
