@@ -44,3 +44,14 @@ def short_msd(tmp_path):
     path = tmp_path / "msd_short.yaml"
     path.write_text(text)
     return str(path)
+
+
+@pytest.fixture
+def short_quarter_car(tmp_path):
+    """scenarios/quarter_car_cdc.yaml over 3 s instead of 10 (objective windows [1, 3])."""
+    text = pathlib.Path(scene_path("quarter_car_cdc.yaml")).read_text()
+    text = text.replace("stop: 10.0", "stop: 3.0").replace("window: [2.0, 10.0]", "window: [1.0, 3.0]")
+    assert "stop: 3.0" in text and "window: [2.0, 10.0]" not in text
+    path = tmp_path / "quarter_car_short.yaml"
+    path.write_text(text)
+    return str(path)

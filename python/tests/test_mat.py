@@ -52,7 +52,7 @@ def test_run_mat_holds_signals_csv_objectives_and_run_json(tmp_path, short_msd):
     units = cells(mat["units"])
     assert units[0] == "s"
     assert units[names.index("body.x")] == "m"
-    assert units[names.index("d(body.x)/d(stiffness)")] == "m / (N/m)"
+    assert units[names.index("d(body.x)/d(stiffness)")] == "m / N/m"
     assert units[names.index("d(body.v)/d(damping)")] == "m/s / (N s/m)"
     structs = scipy.io.loadmat(tmp_path / "run.mat", squeeze_me=True, struct_as_record=False)
     check_json_struct(structs["objectives"], read_json(tmp_path / "objectives.json")["objectives"])

@@ -95,6 +95,7 @@ def test_an_rpc3_recording_replays_as_its_samples_in_csv(tmp_path, rig, data_typ
     names, table = read_signals_csv(tmp_path / "from_rpc" / "signals.csv")
     on_grid = np.round(table[:, 0] / DT).astype(int)
     exact = np.isclose(table[:, 0], on_grid * DT, rtol=0, atol=1e-12)
+    assert exact.sum() == 51  # every 0.02 s over [0, 1]
     np.testing.assert_allclose(table[exact, names.index("pad_fl.y")], decoded[1][on_grid[exact]], rtol=1e-10, atol=1e-14)
     np.testing.assert_allclose(table[exact, names.index("pad_rr.y")], decoded[0][on_grid[exact]], rtol=1e-10, atol=1e-14)
     if data_type == "SHORT_INTEGER":
