@@ -154,11 +154,12 @@ Rpc3File read_rpc3(const std::string& path) {
   const size_t groups = (points + per_group - 1) / per_group;
   const size_t width = f.data_type == Rpc3DataType::short_integer ? 2 : 4;
   const size_t start = static_cast<size_t>(blocks) * kBlock;
-  const size_t needed = groups * per_group * channels * width;
-  if (bytes.size() - start < needed)
-    h.fail("FRAMES", h.text("FRAMES") + " frames of " + h.text("PTS_PER_FRAME") + " points on " + h.text("CHANNELS") +
-                         " channels need " + std::to_string(needed) + " data bytes, the file holds " +
-                         std::to_string(bytes.size() - start));
+  // Compared by division: FRAMES x PTS_PER_FRAME x CHANNELS x width may not fit in 64 bits.
+  const size_t available = (bytes.size() - start) / (channels * width);
+  if (groups * per_group > available)
+    h.fail("FRAMES", h.text("FRAMES") + " frames of " + h.text("PTS_PER_FRAME") + " points need " +
+                         std::to_string(groups * per_group) + " points per channel (whole groups of " +
+                         h.text("PTS_PER_GROUP") + "), the file's data hold " + std::to_string(available));
   for (auto& ch : f.channels) ch.values.resize(points);
   for (size_t g = 0; g < groups; ++g)
     for (long c = 0; c < channels; ++c)

@@ -126,6 +126,7 @@ CASES = [
     ("CHANNELS", lambda r: malformed(r, "CHANNELS", "2.5")),
     ("PTS_PER_GROUP", lambda r: malformed(r, "PTS_PER_GROUP", "48")),
     ("FRAMES", lambda r: malformed(r, "FRAMES", "40")),
+    ("FRAMES", lambda r: malformed(r, "FRAMES", "1000000000")),
     ("SCALE.CHAN_2", lambda r: malformed(r, "SCALE.CHAN_2", drop=True)),
     ("FILE_TYPE", lambda r: malformed(r, "FILE_TYPE", "FATIGUE")),
     ("DESC.CHAN_4", lambda r: malformed(r, "DESC.CHAN_4", "front_left")),
