@@ -70,7 +70,11 @@ void write_table_mat(const std::string& path, const std::string& csv_text, const
   while (std::getline(in, line)) {
     if (line.empty()) continue;
     std::vector<double> row;
-    for (const std::string& cell : split(line)) row.push_back(std::strtod(cell.c_str(), nullptr));
+    for (const std::string& cell : split(line)) {
+      char* end = nullptr;
+      row.push_back(std::strtod(cell.c_str(), &end));
+      if (cell.empty() || *end != '\0') throw std::logic_error("write_table_mat: '" + cell + "' is not a number");
+    }
     if (row.size() != names.size()) throw std::logic_error("write_table_mat: row length differs from the header");
     rows.push_back(std::move(row));
   }
