@@ -3,8 +3,12 @@
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <filesystem>
 
 #include <memory>
+#include <mutex>
 
 #include "engine/diagram.hpp"
 #include "engine/errors.hpp"
@@ -17,9 +21,11 @@ namespace py = pybind11;
 namespace dydp::python {
 namespace {
 
-/// A loaded scene: the frozen diagram, run as often as asked.
+/// A loaded scene: the frozen diagram, run as often as asked. Runs of one scene take turns
+/// (its blocks' instances are shared by them); scenes loaded apart run in parallel.
 struct Scene {
   engine::Diagram diagram;
+  std::unique_ptr<std::mutex> running = std::make_unique<std::mutex>();
 };
 
 /// A run's results with numpy arrays: t [n], signals [n x signal], sensitivities
@@ -94,16 +100,19 @@ RunArrays run_scene(const Scene& scene, bool sensitivities, const py::object& pr
   engine::RunResult r;
   {
     py::gil_scoped_release released;
+    const std::lock_guard<std::mutex> turn(*scene.running);
     r = engine::run(scene.diagram, options);
   }
   return arrays_of(scene.diagram, r);
 }
 
-std::unique_ptr<Scene> load(const std::string& path, const py::dict& overrides) {
+std::unique_ptr<Scene> load(const std::filesystem::path& path, const py::dict& overrides) {
   const auto sets = overrides_from(overrides);
   py::gil_scoped_release released;
   try {
-    return std::make_unique<Scene>(Scene{engine::load_scene(path, sets)});
+    auto scene = std::make_unique<Scene>();
+    scene->diagram = engine::load_scene(path.string(), sets);
+    return scene;
   } catch (const engine::InputError& e) {
     // The loader names an override by its command-line option; here it came from `overrides`.
     const std::string option = "--set: " + e.field() + ": ", what = e.what();
@@ -180,11 +189,16 @@ void add_scene_bindings(py::module_& m) {
           [](Scene& s, const std::string& name, double value) {
             const int index = s.diagram.find_parameter(name);
             if (index < 0) throw engine::InputError(s.diagram.file, 0, name, "no scene parameter of that name");
+            // Waits for a run of this scene to end without holding the GIL (its progress
+            // callback needs it).
+            py::gil_scoped_release released;
+            const std::lock_guard<std::mutex> turn(*s.running);
             s.diagram.set_parameter(index, value);
           },
           py::arg("name"), py::arg("value"), "sets a scene parameter (checked against its range)")
       .def("run", &run_scene, py::arg("sensitivities") = true, py::arg("progress") = py::none(),
-           "Runs the scene (the GIL released); progress(t) is called at every output time.")
+           "Runs the scene (the GIL released); progress(t) is called at every output time. "
+           "Runs of one scene take turns; load a scene per thread to run in parallel.")
       .def("__repr__", [](const Scene& s) { return "<dydp.Scene " + s.diagram.scene_name + " from " + s.diagram.file + ">"; });
 
   m.def("load", &load, py::arg("scene"), py::arg("overrides") = py::dict(),
@@ -192,7 +206,7 @@ void add_scene_bindings(py::module_& m) {
         "Bad input raises dydp.InputError with file, line and field.");
   m.def(
       "run",
-      [](const std::string& path, const py::dict& overrides, bool sensitivities, const py::object& progress) {
+      [](const std::filesystem::path& path, const py::dict& overrides, bool sensitivities, const py::object& progress) {
         const std::unique_ptr<Scene> scene = load(path, overrides);
         return run_scene(*scene, sensitivities, progress);
       },

@@ -2,6 +2,9 @@
 // the cores, the GIL released), optionally central differences, as numpy arrays.
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <filesystem>
 
 #include "engine/sweep.hpp"
 #include "python/bindings.hpp"
@@ -19,10 +22,10 @@ struct SweepArrays {
   py::array_t<double> p, values, gradients, fd, cpu_seconds;
 };
 
-SweepArrays sweep(const std::string& path, const std::string& parameter, double low, double high, int points,
+SweepArrays sweep(const std::filesystem::path& path, const std::string& parameter, double low, double high, int points,
                   const py::dict& overrides, const std::vector<double>& fd_steps, int threads) {
   engine::SweepSpec spec;
-  spec.scene = path;
+  spec.scene = path.string();
   spec.overrides = overrides_from(overrides);
   spec.parameter = parameter;
   spec.low = low, spec.high = high, spec.points = points;

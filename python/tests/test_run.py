@@ -1,5 +1,6 @@
 """dydp.load / run against the dydp program's own output files, and the sensitivities against
 central differences."""
+import pathlib
 import threading
 import time
 
@@ -123,3 +124,33 @@ def test_a_run_releases_the_gil(short_quarter_car):
     assert duration > 0.2, "the run is too short to tell"
     gaps = np.diff(np.array([start, *stamps]))
     assert gaps.max() < 0.5 * duration, (gaps.max(), duration)
+
+
+def test_set_parameter_equals_loading_with_the_override(short_msd):
+    scene = dydp.load(pathlib.Path(short_msd))  # a path object as well as a string
+    scene.set_parameter("damping", 2.5)
+    assert scene.parameters["damping"]["value"] == 2.5
+    again = dydp.run(short_msd, {"damping": 2.5})
+    assert scene.run().objectives == again.objectives
+    with pytest.raises(dydp.InputError) as caught:
+        scene.set_parameter("damping", 99.0)  # its range is [0, 50]
+    assert caught.value.field == "parameters.damping"
+
+
+def test_runs_of_one_scene_from_two_threads_take_turns(short_msd):
+    scene = dydp.load(short_msd)
+    alone = scene.run()
+    results = [None, None]
+
+    def run(k):
+        results[k] = scene.run(progress=lambda t: None)
+
+    threads = [threading.Thread(target=run, args=(k,)) for k in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in results:
+        np.testing.assert_array_equal(r.signals, alone.signals)
+        np.testing.assert_array_equal(r.sensitivities, alone.sensitivities)
+        assert r.objectives == alone.objectives
