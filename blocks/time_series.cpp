@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <sstream>
 
-#include "engine/csv.hpp"
+#include "engine/recording.hpp"
 #include "engine/errors.hpp"
 
 namespace dydp::blocks {
@@ -65,9 +65,9 @@ std::vector<TimeSeries> read_time_series(const engine::BlockSettings& s, const s
   const std::string file = s.path(file_key);
   engine::CsvFile csv;
   try {
-    csv = engine::read_csv(file);
+    csv = engine::read_recording(file);
   } catch (const engine::InputError& e) {
-    if (e.line() == 0) s.fail(file_key, "cannot open '" + file + "'");
+    if (e.line() == 0 && e.field().empty()) s.fail(file_key, "cannot open '" + file + "'");
     throw;
   }
   const int ct = csv.find(time_column);

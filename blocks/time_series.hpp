@@ -1,6 +1,7 @@
 // Recorded signals against time for source blocks (tables, steering records, shaker pads):
-// read from a CSV file named in the block's settings, interpolated linearly or by cubic Hermite
-// segments (value and slope continuous: a recorded displacement and its rate).
+// read from a recording (CSV or RPC III, engine/recording.hpp) named in the block's settings,
+// interpolated linearly or by cubic Hermite segments (value and slope continuous: a recorded
+// displacement and its rate).
 #pragma once
 
 #include <optional>
@@ -34,7 +35,7 @@ class TimeSeries {
 /// its end value is held), or nothing when it covers it: a warning rule of recorded inputs.
 std::optional<std::string> uncovered_span(const TimeSeries& series, double t_start, double t_stop);
 
-/// Reads the columns `columns` against `time_column` from the CSV file in setting `file_key`;
+/// Reads the columns `columns` against `time_column` from the recording in setting `file_key`;
 /// errors name the setting (missing column) or the file and row (bad data, times not
 /// increasing, fewer than two rows).
 std::vector<TimeSeries> read_time_series(const engine::BlockSettings& s, const std::string& file_key,

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Fuzzes the scene loader and the CSV reader with libFuzzer under ASan+UBSan (docs/fuzzing.md).
-#   bash scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     default: 60 s, both targets
+# Fuzzes the scene loader, the CSV reader and the RPC III reader with libFuzzer under ASan+UBSan (docs/fuzzing.md).
+#   bash scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     default: 60 s, every target
 # Builds in build/fuzz with clang-14 (Debian: clang-14, libclang-rt-14-dev), seeds the corpora
 # from scenarios/ and a few CSV tables, and keeps corpora and crash files in build/fuzz/.
 set -euo pipefail
@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(scene_loader_fuzz csv_fuzz)
+[ ${#targets[@]} -gt 0 ] || targets=(scene_loader_fuzz csv_fuzz rpc3_fuzz)
 
 build=build/fuzz
 CC=clang-14 CXX=clang++-14 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -20,6 +20,18 @@ mkdir -p "$build/corpus/scene_loader_fuzz" "$build/corpus/csv_fuzz" "$build/arti
 find scenarios -name '*.yaml' -exec cp {} "$build/corpus/scene_loader_fuzz/" \;
 printf 't,fl,fr,rl,rr\n0,0,0,0,0\n0.5,0.01,0,0,0\n1.0,0.0,0.002,-0.001,0\n' >"$build/corpus/csv_fuzz/bench.csv"
 printf 't,z\n0.0,0.0\n0.5, 1e-3\n\n1.0,2.5e-2\r\n' >"$build/corpus/csv_fuzz/table.csv"
+# RPC III seeds of both data types, written by the tests' numpy writer (python/tests/rpc3_file.py).
+mkdir -p "$build/corpus/rpc3_fuzz"
+/usr/bin/python3 - "$build/corpus/rpc3_fuzz" <<'PY'
+import sys
+import numpy as np
+sys.path.insert(0, "python/tests")
+import rpc3_file
+t = np.arange(40) * 0.01
+channels = [("fl", "m", 0.01 * np.sin(t)), ("fr", "m", 0.02 * np.cos(3 * t))]
+for data_type in ("SHORT_INTEGER", "FLOATING_POINT"):
+    rpc3_file.write(f"{sys.argv[1]}/{data_type.lower()}.rsp", channels, 0.01, data_type, pts_per_frame=16, frames_per_group=2)
+PY
 
 status=0
 for target in "${targets[@]}"; do

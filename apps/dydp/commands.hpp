@@ -17,6 +17,7 @@ struct RunArgs {
   std::vector<std::string> sets;  ///< NAME=VALUE
   bool no_sens = false;
   bool report = false;
+  std::string format = "csv";     ///< csv | mat (also run.mat)
 };
 
 struct SweepArgs {
@@ -29,6 +30,7 @@ struct SweepArgs {
   std::vector<double> fd_steps;   ///< --fd: absolute steps for central differences
   double delta = 0.0;             ///< --delta: report the change of psi for this step of p
   bool report = false;
+  std::string format = "csv";     ///< csv | mat (also sweep.mat)
 };
 
 struct AccuracyArgs {
@@ -49,6 +51,7 @@ struct ReplayArgs {
   std::vector<std::string> sets;
   bool realtime = false;          ///< pace to the wall clock
   bool no_sens = false;
+  std::string format = "csv";     ///< csv | mat (also replay.mat) | rpc (also signals.rsp)
 };
 
 int run_command(const RunArgs& args);

@@ -34,6 +34,8 @@ int main(int argc, char** argv) {
   run->add_flag("--no-sens", run_args.no_sens, "run without sensitivities");
   run->add_flag("--report", run_args.report, "also write plots (gnuplot) and report.md");
   add_solver_options(run, run_args.solver);
+  run->add_option("--format", run_args.format, "csv: the CSV/JSON files; mat: also run.mat (MAT v5)")
+      ->check(CLI::IsMember({"csv", "mat"}))->capture_default_str();
 
   dydp::apps::SweepArgs sweep_args;
   CLI::App* sweep = app.add_subcommand("sweep", "psi and d(psi)/dp over a range of one parameter");
@@ -46,6 +48,8 @@ int main(int argc, char** argv) {
   sweep->add_option("--delta", sweep_args.delta, "report the change of psi for this step of the parameter");
   sweep->add_flag("--report", sweep_args.report, "also write plots (gnuplot) and report.md");
   add_solver_options(sweep, sweep_args.solver);
+  sweep->add_option("--format", sweep_args.format, "csv: the CSV/JSON files; mat: also sweep.mat (MAT v5)")
+      ->check(CLI::IsMember({"csv", "mat"}))->capture_default_str();
 
   dydp::apps::AccuracyArgs accuracy_args;
   CLI::App* accuracy = app.add_subcommand("accuracy", "Error against run time over solvers and tolerances");
@@ -62,12 +66,16 @@ int main(int argc, char** argv) {
   dydp::apps::ReplayArgs replay_args;
   CLI::App* replay = app.add_subcommand("replay", "Replay recorded test-bench input through a scene");
   replay->add_option("scene", replay_args.scene, "scene file (YAML)")->required();
-  replay->add_option("--input", replay_args.input, "recorded CSV: t, one column per pad (named in the scene), measured outputs")->required();
+  replay->add_option("--input", replay_args.input, "recorded CSV (t, one column per pad named in the scene, measured outputs) "
+                     "or RPC III file (.rsp, .drv, .tim: channels named by their descriptions)")->required();
   replay->add_option("--out", replay_args.out, "output folder")->capture_default_str();
   replay->add_option("--set", replay_args.sets, "override a scene parameter: NAME=VALUE");
   replay->add_flag("--realtime", replay_args.realtime, "pace the run to the wall clock and report missed deadlines");
   replay->add_flag("--no-sens", replay_args.no_sens, "run without sensitivities");
   add_solver_options(replay, replay_args.solver);
+  replay->add_option("--format", replay_args.format,
+                     "csv: the CSV/JSON files; mat: also replay.mat (MAT v5); rpc: also signals.rsp (RPC III)")
+      ->check(CLI::IsMember({"csv", "mat", "rpc"}))->capture_default_str();
 
   CLI::App* blocks = app.add_subcommand("blocks", "List the block types with ports and parameters");
 

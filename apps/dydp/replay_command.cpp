@@ -12,10 +12,12 @@
 #include <thread>
 
 #include "apps/dydp/commands.hpp"
-#include "engine/csv.hpp"
+#include "engine/recording.hpp"
 #include "engine/errors.hpp"
 #include "engine/output_writer.hpp"
 #include "engine/run.hpp"
+#include "io/mat_outputs.hpp"
+#include "io/rpc3_outputs.hpp"
 
 namespace dydp::apps {
 namespace {
@@ -69,7 +71,7 @@ class StreamingCsv {
 }  // namespace
 
 int replay_command(const ReplayArgs& args) {
-  const engine::CsvFile recorded = engine::read_csv(args.input);
+  const engine::CsvFile recorded = engine::read_recording(args.input);
   if (recorded.names.empty() || recorded.names[0] != "t")
     throw engine::InputError(args.input, 1, "t", "the first column must be the time t [s]");
   const std::string input = std::filesystem::absolute(args.input).string();
@@ -140,7 +142,11 @@ int replay_command(const ReplayArgs& args) {
     std::cout << "  " << recorded.names[c] << ": rms error " << rms << ", correlation " << corr << "\n";
   }
   engine::write_file_atomically(args.out + "/replay.json", j.dump(2) + "\n");
-  std::cout << "  results in " << args.out << "/ (signals.csv streamed, objectives.json, run.json, replay.json)\n";
+  if (args.format == "mat") io::write_run_mat(args.out + "/replay.mat", d, r, {{"replay", j.dump()}});
+  if (args.format == "rpc")
+    engine::write_file_atomically(args.out + "/signals.rsp", io::run_rpc3(d, r, engine::Rpc3DataType::floating_point));
+  std::cout << "  results in " << args.out << "/ (signals.csv streamed, objectives.json, run.json, replay.json"
+            << (args.format == "mat" ? ", replay.mat" : args.format == "rpc" ? ", signals.rsp" : "") << ")\n";
   return 0;
 }
 

@@ -10,6 +10,7 @@
 #include "engine/errors.hpp"
 #include "engine/output_writer.hpp"
 #include "engine/run.hpp"
+#include "io/mat_outputs.hpp"
 
 namespace dydp::apps {
 
@@ -59,6 +60,7 @@ int run_command(const RunArgs& args) {
   if (tty) std::cerr << "\r" << std::string(60, ' ') << "\r";
 
   engine::write_outputs(args.out, d, r);
+  if (args.format == "mat") io::write_run_mat(args.out + "/run.mat", d, r);
   if (args.report) write_report(args.out, d, r);
 
   std::cout << d.scene_name << ": " << r.stats.method << ", " << r.stats.steps << " steps, "
@@ -81,7 +83,7 @@ int run_command(const RunArgs& args) {
     std::cout << "\n";
   }
   std::cout << "  results in " << args.out << "/ (signals.csv, objectives.json, run.json"
-            << (args.report ? ", report.md" : "") << ")\n";
+            << (args.format == "mat" ? ", run.mat" : "") << (args.report ? ", report.md" : "") << ")\n";
   return 0;
 }
 

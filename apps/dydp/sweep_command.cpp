@@ -10,6 +10,7 @@
 #include "engine/errors.hpp"
 #include "engine/output_writer.hpp"
 #include "engine/sweep.hpp"
+#include "io/mat_outputs.hpp"
 
 namespace dydp::apps {
 namespace {
@@ -97,6 +98,7 @@ int sweep_command(const SweepArgs& args) {
   }
   engine::write_file_atomically(args.out + "/sweep.csv", csv);
   engine::write_file_atomically(args.out + "/sweep.json", j.dump(2) + "\n");
+  if (args.format == "mat") io::write_table_mat(args.out + "/sweep.mat", csv, {{"sweep", j.dump()}});
   if (args.report) write_sweep_report(args.out, args.scene, r, args.delta);
 
   std::cout << std::setprecision(6);
@@ -114,7 +116,8 @@ int sweep_command(const SweepArgs& args) {
       std::cout << "\n";
     }
   }
-  std::cout << "results in " << args.out << "/ (sweep.csv, sweep.json" << (args.report ? ", report.md" : "") << ")\n";
+  std::cout << "results in " << args.out << "/ (sweep.csv, sweep.json" << (args.format == "mat" ? ", sweep.mat" : "")
+            << (args.report ? ", report.md" : "") << ")\n";
   return 0;
 }
 
