@@ -75,6 +75,13 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   edit->addAction(redo);
   auto* act_delete = edit->addAction(tr("&Delete"), this, [this] { canvas_->delete_selection(); });
   edit->addAction(tr("&Fit diagram"), this, [this] { canvas_->fit_all(); });
+  auto* view = menuBar()->addMenu(tr("&View"));
+  view->addAction(tr("&Open subsystem"), QKeySequence(Qt::ALT | Qt::Key_Down), this, [this] {
+    const QStringList sel = canvas_->selected_blocks();
+    if (sel.size() != 1 || !canvas_->open_subsystem(sel.front()))
+      status(tr("select one subsystem block (or double-click it) to open it"));
+  });
+  view->addAction(tr("&Up from subsystem"), QKeySequence(Qt::ALT | Qt::Key_Up), this, [this] { canvas_->close_subsystem(); });
   run_action_ = run_menu->addAction(tr("&Run"), QKeySequence(Qt::Key_F5), this, [this] { start_run(); });
   cancel_action_ = run_menu->addAction(tr("&Cancel"), QKeySequence(Qt::Key_Escape), this, [this] { worker_.cancel(); });
   cancel_action_->setEnabled(false);
@@ -92,6 +99,18 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   progress_->setMaximumWidth(220);
   progress_->setFormat("%p%");
   tools->addWidget(progress_);
+
+  // Where the canvas is: the scene, or the subsystem instances opened; each entry goes back there.
+  auto* where = addToolBar(tr("Level"));
+  where->setObjectName("level_toolbar");
+  breadcrumb_ = new QLabel;
+  breadcrumb_->setTextFormat(Qt::RichText);
+  where->addWidget(breadcrumb_);
+  connect(breadcrumb_, &QLabel::linkActivated, this, [this](const QString& link) {
+    canvas_->close_subsystem(static_cast<int>(canvas_->level().size()) - link.toInt());
+  });
+  connect(canvas_, &Canvas::level_changed, this, &MainWindow::update_breadcrumb);
+  update_breadcrumb(canvas_->level());
 
   status_label_ = new QLabel;
   statusBar()->addWidget(status_label_, 1);
@@ -117,6 +136,15 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
 }
 
 void MainWindow::status(const QString& text) { status_label_->setText(text); }
+
+void MainWindow::update_breadcrumb(const QStringList& level) {
+  QString text = level.isEmpty() ? tr("<b>scene</b>") : QString("<a href=\"0\">%1</a>").arg(tr("scene"));
+  for (qsizetype i = 0; i < level.size(); ++i)
+    text += " \u25b8 " + (i + 1 == level.size() ? "<b>" + level[i].toHtmlEscaped() + "</b>"
+                                                : QString("<a href=\"%1\">%2</a>").arg(i + 1).arg(level[i].toHtmlEscaped()));
+  if (!level.isEmpty()) text += tr("  <i>(read only; Alt+Up: back)</i>");
+  breadcrumb_->setText(text);
+}
 
 void MainWindow::update_title() {
   const QString path = controller_.file_path();

@@ -29,6 +29,7 @@ class MainWindow : public QMainWindow {
   PropertyEditor* property_editor() { return properties_; }
   ScenePanel* scene_panel() { return scene_panel_; }
   ResultsPanel* results() { return results_; }
+  QLabel* breadcrumb() { return breadcrumb_; }
   RunWorker* worker() { return &worker_; }
   QProgressBar* progress_bar() { return progress_; }
 
@@ -51,6 +52,7 @@ class MainWindow : public QMainWindow {
   void update_title();
   void run_finished(const RunOutcome& outcome);
   void status(const QString& text);
+  void update_breadcrumb(const QStringList& level);
 
   SceneController controller_;
   RunWorker worker_;
@@ -63,6 +65,7 @@ class MainWindow : public QMainWindow {
   QAction* run_action_;
   QAction* cancel_action_;
   QLabel* status_label_;
+  QLabel* breadcrumb_;
   QString last_error_;
 };
 

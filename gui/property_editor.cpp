@@ -111,7 +111,10 @@ void PropertyEditor::refresh() {
   }
   name_->setText(block_);
   type_->setText(q(b->type));
-  summary_->setText(type ? q(type->summary) : tr("unknown block type"));
+  const DocSubsystem* def = doc.subsystem_of(*b);
+  summary_->setText(type ? q(type->summary)
+                         : def ? tr("subsystem %1: %2 (double-click the block to open it)").arg(q(def->name), q(def->description))
+                               : tr("unknown block type"));
   auto add_row = [&](const QString& key, const QString& value, const QString& unit, const QString& def,
                      const QString& range, const QString& tip, bool setting) {
     const int row = table_->rowCount();
@@ -144,6 +147,12 @@ void PropertyEditor::refresh() {
               s.required ? tr("required") : q(s.default_value), {}, q(s.description), true);
     }
   }
+  if (def)
+    for (const auto& [name, default_value] : def->parameters) {
+      const SceneValue* v = b->find(name);
+      add_row(q(name), v ? q(v->text()) : QString(), {}, default_value.items.empty() ? tr("required") : q(default_value.text()),
+              {}, tr("parameter of subsystem %1").arg(q(def->name)), false);
+    }
   const BlockPorts ports = controller_->ports(b->name);
   auto add_output = [&](const QString& label, const QString& ref) {
     auto* item = new QListWidgetItem(label, outputs_);

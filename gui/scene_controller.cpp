@@ -1,5 +1,7 @@
 #include "gui/scene_controller.hpp"
 
+#include "gui/subsystem_ports.hpp"
+
 #include <QDir>
 #include <QFileInfo>
 #include <QRegularExpression>
@@ -63,6 +65,7 @@ void SceneController::new_scene() {
 void SceneController::open(const QString& path) {
   SceneDocument doc = read_scene_file(s(path));
   place_unplaced_blocks(doc);
+  for (DocSubsystem& def : doc.subsystems) place_unplaced_blocks(def.blocks, def.connections);
   undo_.clear();
   path_ = path;
   replace(doc);
@@ -93,6 +96,7 @@ const engine::BlockType* SceneController::type_of(const std::string& block) cons
 
 BlockPorts SceneController::ports(const std::string& block) const {
   const DocBlock* b = doc_.find_block(block);
+  if (b && doc_.subsystem_of(*b)) return instance_ports(doc_, *b);
   const engine::BlockType* type = b ? engine::Registry::global().find(b->type) : nullptr;
   if (!type) {
     BlockPorts none;
@@ -108,16 +112,21 @@ BlockPorts SceneController::ports(const std::string& block) const {
 }
 
 void SceneController::place_unplaced_blocks(SceneDocument& doc) const {
+  place_unplaced_blocks(doc.blocks, doc.connections);
+}
+
+void SceneController::place_unplaced_blocks(std::vector<DocBlock>& blocks,
+                                            const std::vector<DocConnection>& connections) const {
   // Columns by signal flow: a block sits one column right of the furthest block driving it
   // (longest path from the sources; cycles stop growing after as many rounds as blocks).
   std::map<std::string, int> column;
-  for (const auto& b : doc.blocks) column[b.name] = 0;
-  for (size_t round = 0; round < doc.blocks.size(); ++round) {
+  for (const auto& b : blocks) column[b.name] = 0;
+  for (size_t round = 0; round < blocks.size(); ++round) {
     bool changed = false;
-    for (const auto& c : doc.connections) {
+    for (const auto& c : connections) {
       if (!column.count(c.from.block) || !column.count(c.to.block) || c.from.block == c.to.block) continue;
       const int want = column[c.from.block] + 1;
-      if (column[c.to.block] < want && want < static_cast<int>(doc.blocks.size())) {
+      if (column[c.to.block] < want && want < static_cast<int>(blocks.size())) {
         column[c.to.block] = want;
         changed = true;
       }
@@ -125,7 +134,7 @@ void SceneController::place_unplaced_blocks(SceneDocument& doc) const {
     if (!changed) break;
   }
   std::map<int, int> rows;
-  for (auto& b : doc.blocks) {
+  for (auto& b : blocks) {
     const int col = column[b.name];
     const int row = rows[col]++;
     if (b.placed) continue;
@@ -258,9 +267,20 @@ QString SceneController::set_block_value(const QString& block_name, const QStrin
   SceneDocument after = doc_;
   DocBlock* b = after.find_block(s(block_name));
   if (!b) return tr("no block '%1'").arg(block_name);
+  const QString field = block_name + "." + key_q;
+  if (const DocSubsystem* def = doc_.subsystem_of(*b)) {
+    // An instance's parameter: a value for the subsystem (checked by the engine where it is used).
+    const bool known = std::any_of(def->parameters.begin(), def->parameters.end(),
+                                   [&](const auto& p) { return p.first == key; });
+    if (!known) return tr("%1: unknown parameter of subsystem %2").arg(field, q(def->name));
+    if (!text.empty() && text[0] == '$' && !doc_.find_parameter(text.substr(1)))
+      return tr("%1: unknown scene parameter '%2'").arg(field, q(text));
+    b->set(key, text.empty() ? SceneValue::scalar("") : SceneValue::parse(text));
+    commit(tr("Set %1").arg(field), std::move(after));
+    return {};
+  }
   const engine::BlockType* type = engine::Registry::global().find(b->type);
   if (!type) return tr("unknown block type '%1'").arg(q(b->type));
-  const QString field = block_name + "." + key_q;
 
   if (const int j = parameter_index(*type, key); j >= 0) {
     const engine::ParamSpec& spec = type->parameters[j];

@@ -81,6 +81,7 @@ class SceneController : public QObject {
   void commit(const QString& label, SceneDocument after);
   void replace(const SceneDocument& doc);
   void place_unplaced_blocks(SceneDocument& doc) const;
+  void place_unplaced_blocks(std::vector<DocBlock>& blocks, const std::vector<DocConnection>& connections) const;
   /// Drops connections and outputs that the block's current ports no longer support.
   void drop_dangling(SceneDocument& doc, const std::string& block) const;
 
