@@ -128,7 +128,12 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   });
   connect(&controller_, &SceneController::file_changed, this, &MainWindow::update_title);
   connect(controller_.undo_stack(), &QUndoStack::cleanChanged, this, &MainWindow::update_title);
-  connect(&controller_, &SceneController::document_changed, this, [this] { canvas_->clear_errors(); });
+  // An edit makes the last message stale (a refusal, an invalid scene): clear it; a message the
+  // edit itself sends comes after this.
+  connect(&controller_, &SceneController::document_changed, this, [this] {
+    canvas_->clear_errors();
+    status({});
+  });
   connect(&worker_, &RunWorker::progress, this, [this](double f) { progress_->setValue(static_cast<int>(f * 1000)); });
   connect(&worker_, &RunWorker::finished, this, &MainWindow::run_finished);
   resize(1500, 950);
@@ -207,7 +212,12 @@ bool MainWindow::start_run() {
     const QStringList blocks = controller_.blocks_of_error(e);
     canvas_->show_error(blocks, last_error_);
     if (blocks.size() == 1) canvas_->select_block(blocks.front());
-    status(tr("invalid scene: %1").arg(last_error_));
+    if (e.field() == "outputs" && controller_.document().outputs.empty())
+      // A new diagram: say where outputs are chosen rather than what the file lacks.
+      status(tr("Nothing to compute yet: select a block and tick the signals to log under \"Logged outputs\" "
+                "in the Block tab, or drop an objective block (objectives are computed by default)."));
+    else
+      status(tr("invalid scene: %1").arg(last_error_));
     return false;
   }
   last_error_.clear();
@@ -225,7 +235,7 @@ void MainWindow::run_finished(const RunOutcome& outcome) {
   switch (outcome.status) {
     case RunOutcome::Status::finished: {
       progress_->setValue(1000);
-      results_->show_result(outcome.result);
+      results_->show_result(outcome.result, outcome.diagram);
       std::map<std::string, QString> notes;
       for (const auto& o : outcome.result->objectives) notes[o.name] = QString("ψ = %1").arg(o.value, 0, 'g', 6);
       canvas_->set_notes(notes);

@@ -30,6 +30,8 @@ class MainWindow : public QMainWindow {
   ScenePanel* scene_panel() { return scene_panel_; }
   ResultsPanel* results() { return results_; }
   QLabel* breadcrumb() { return breadcrumb_; }
+  /// The message shown in the status bar.
+  QString status_text() const { return status_label_->text(); }
   RunWorker* worker() { return &worker_; }
   QProgressBar* progress_bar() { return progress_; }
 

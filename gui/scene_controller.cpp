@@ -158,6 +158,8 @@ QString SceneController::add_block(const QString& type_name, QPointF pos) {
   for (const auto& p : type->parameters)
     if (p.required) b.set(p.name, SceneValue::scalar(number_text(p.default_value)));
   after.blocks.push_back(b);
+  // A new objective is computed by default: that is what it was dropped for.
+  if (ports_of(*type, b).is_objective) after.outputs.push_back(b.name);
   commit(tr("Add %1").arg(q(b.name)), std::move(after));
   return q(b.name);
 }
@@ -435,6 +437,43 @@ QString SceneController::remove_scene_parameter(const QString& name_q) {
   std::erase_if(after.parameters, [&](const DocParameter& p) { return p.name == s(name_q); });
   std::erase(after.sensitivities, s(name_q));
   commit(tr("Delete parameter %1").arg(name_q), std::move(after));
+  return {};
+}
+
+QString SceneController::make_direction(const QString& block_q, const QString& key_q, QString* parameter) {
+  const std::string block = s(block_q), key = s(key_q);
+  const DocBlock* b = doc_.find_block(block);
+  if (!b) return tr("no block '%1'").arg(block_q);
+  const engine::BlockType* type = engine::Registry::global().find(b->type);
+  const int j = type ? parameter_index(*type, key) : -1;
+  if (j < 0) return tr("%1.%2: not a numeric parameter of %3").arg(block_q, key_q, q(b->type));
+  const engine::ParamSpec& spec = type->parameters[j];
+  if (!spec.differentiable)
+    return tr("%1.%2: not differentiable, cannot be a sensitivity direction").arg(block_q, key_q);
+  SceneDocument after = doc_;
+  DocBlock* target = after.find_block(block);
+  const SceneValue* v = target->find(key);
+  std::string name;
+  if (v && !v->is_list && !v->items.empty() && v->items.front().size() > 1 && v->items.front()[0] == '$') {
+    // Already driven by a scene parameter: that one becomes the direction.
+    name = v->items.front().substr(1);
+    if (!after.find_parameter(name)) return tr("%1.%2: unknown scene parameter '$%3'").arg(block_q, key_q, q(name));
+  } else {
+    // A new scene parameter named after the block and parameter, starting at the value in use.
+    name = after.unique_parameter_name(block + "_" + key);
+    DocParameter p;
+    p.name = name;
+    p.value = v && !v->items.empty() && !v->items.front().empty() ? v->items.front() : number_text(spec.default_value);
+    p.unit = spec.unit;
+    double value = 0;
+    if (!engine::parse_number(p.value, value)) return tr("%1.%2: malformed number '%3'").arg(block_q, key_q, q(p.value));
+    after.parameters.push_back(p);
+    target->set(key, SceneValue::scalar("$" + name));
+  }
+  if (std::find(after.sensitivities.begin(), after.sensitivities.end(), name) == after.sensitivities.end())
+    after.sensitivities.push_back(name);
+  if (parameter) *parameter = q(name);
+  commit(tr("Make %1.%2 a direction").arg(block_q, key_q), std::move(after));
   return {};
 }
 

@@ -60,6 +60,10 @@ class SceneController : public QObject {
   QString update_scene_parameter(const QString& name, const DocParameter& p);
   QString remove_scene_parameter(const QString& name);
   void set_sensitivity(const QString& name, bool on);
+  /// Makes a block parameter a sensitivity direction in one step: the scene parameter driving it
+  /// (`$name`), or a new one named BLOCK_PARAMETER holding its current value and unit, becomes a
+  /// direction. `parameter` receives the scene parameter's name.
+  QString make_direction(const QString& block, const QString& key, QString* parameter = nullptr);
 
   /// The ports of a block of the document (cached per type and settings).
   BlockPorts ports(const std::string& block) const;

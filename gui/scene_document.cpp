@@ -134,3 +134,15 @@ std::string SceneDocument::unique_block_name(const std::string& stem) const {
 }
 
 }  // namespace dydp::gui
+
+namespace dydp::gui {
+
+std::string SceneDocument::unique_parameter_name(const std::string& stem) const {
+  if (!find_parameter(stem)) return stem;
+  for (int i = 2;; ++i) {
+    const std::string name = stem + std::to_string(i);
+    if (!find_parameter(name)) return name;
+  }
+}
+
+}  // namespace dydp::gui

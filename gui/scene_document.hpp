@@ -114,6 +114,8 @@ struct SceneDocument {
   const DocConnection* driver_of(const PortRef& to) const;
   /// A block name not yet used, from a stem ("sine" -> "sine", "sine2", ...).
   std::string unique_block_name(const std::string& stem) const;
+  /// A scene parameter name not yet used, from a stem.
+  std::string unique_parameter_name(const std::string& stem) const;
   bool operator==(const SceneDocument&) const = default;
 };
 
