@@ -159,13 +159,39 @@ bool Canvas::make_view(View& v) const {
   return true;
 }
 
+void Canvas::toggle_all_ports(const QString& block) {
+  const std::string name = block.toStdString();
+  if (!all_ports_.erase(name)) all_ports_.insert(name);
+  sync();
+}
+
+BlockPorts Canvas::shown_ports(const View& view, const std::string& block) const {
+  // A block with very many ports (a whole car) shows those in use; the rest on request.
+  BlockPorts ports = view.ports.at(block);
+  if (ports.inputs.size() + ports.outputs.size() <= kPortsShownAll || all_ports_.count(block)) return ports;
+  std::set<std::string> used_in, used_out;
+  for (const DocConnection& c : view.connections) {
+    if (c.to.block == block) used_in.insert(c.to.port);
+    if (c.from.block == block) used_out.insert(c.from.port);
+  }
+  for (const std::string& o : view.outputs) {
+    PortRef r;
+    if (PortRef::parse(o, r) && r.block == block) used_out.insert(r.port);
+  }
+  std::erase_if(ports.inputs, [&](const engine::PortDecl& p) { return !used_in.count(p.name); });
+  std::erase_if(ports.outputs, [&](const engine::PortDecl& p) { return !used_out.count(p.name); });
+  return ports;
+}
+
 void Canvas::draw(const View& view) {
   const bool editable = level_.isEmpty();
   // Blocks: keep items whose shape is unchanged (selection and error marks survive), remake others.
   std::set<std::string> present;
   for (const DocBlock& b : view.blocks) {
     present.insert(b.name);
-    const BlockPorts& ports = view.ports.at(b.name);
+    const BlockPorts ports = shown_ports(view, b.name);
+    const BlockPorts& all = view.ports.at(b.name);
+    const size_t hidden = all.inputs.size() + all.outputs.size() - ports.inputs.size() - ports.outputs.size();
     BlockItem* item = block_item(b.name);
     bool reselect = false;
     if (item && !item->same_shape(b, ports)) {
@@ -182,7 +208,10 @@ void Canvas::draw(const View& view) {
       blocks_.erase(b.name);
     }
     if (!item) {
-      item = new BlockItem(b, view.summaries.at(b.name), ports);
+      std::string summary = view.summaries.at(b.name);
+      if (hidden > 0)
+        summary += "\n" + std::to_string(hidden) + " ports not in use are hidden: View > Show all ports";
+      item = new BlockItem(b, summary, ports);
       const std::string name = b.name;
       item->on_moved = [this, name] { update_wires_of(name); };
       scene_.addItem(item);

@@ -5,6 +5,7 @@
 
 #include <QGraphicsView>
 #include <map>
+#include <set>
 
 #include "gui/diagram_items.hpp"
 #include "gui/scene_controller.hpp"
@@ -48,6 +49,10 @@ class Canvas : public QGraphicsView {
   void close_subsystem(int levels = 1);
   /// The instances opened, outermost first; empty at the scene's level.
   const QStringList& level() const { return level_; }
+  /// A block with more than kPortsShownAll ports shows only those wired or logged, unless
+  /// toggled to show all (View > Show all ports).
+  static constexpr size_t kPortsShownAll = 30;
+  void toggle_all_ports(const QString& block);
   /// Whether the level shown is the scene's own (editable) one.
   bool at_scene_level() const { return level_.isEmpty(); }
 
@@ -82,6 +87,7 @@ class Canvas : public QGraphicsView {
   /// The view of level_, or false when a level no longer exists (then back to the scene).
   bool make_view(View& view) const;
   void draw(const View& view);
+  BlockPorts shown_ports(const View& view, const std::string& block) const;
   void grow_scene_rect();
   PortItem* port_at(QPoint view_pos) const;
   void update_wires_of(const std::string& block);
@@ -97,6 +103,7 @@ class Canvas : public QGraphicsView {
   QGraphicsPathItem* drag_wire_ = nullptr;
   QStringList level_;
   QString shown_file_;
+  std::set<std::string> all_ports_;  ///< blocks showing every port
 };
 
 }  // namespace dydp::gui

@@ -81,6 +81,9 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     if (sel.size() != 1 || !canvas_->open_subsystem(sel.front()))
       status(tr("select one subsystem block (or double-click it) to open it"));
   });
+  view->addAction(tr("Show &all ports of the selected block"), this, [this] {
+    for (const QString& b : canvas_->selected_blocks()) canvas_->toggle_all_ports(b);
+  });
   view->addAction(tr("&Up from subsystem"), QKeySequence(Qt::ALT | Qt::Key_Up), this, [this] { canvas_->close_subsystem(); });
   run_action_ = run_menu->addAction(tr("&Run"), QKeySequence(Qt::Key_F5), this, [this] { start_run(); });
   cancel_action_ = run_menu->addAction(tr("&Cancel"), QKeySequence(Qt::Key_Escape), this, [this] { worker_.cancel(); });

@@ -93,6 +93,8 @@ ResultsPanel::ResultsPanel(QWidget* parent) : QWidget(parent) {
   split->addWidget(left);
   split->addWidget(charts);
   split->setStretchFactor(1, 3);
+  // Wide enough for an objective, a dψ/dp label and a value to the last digit with its unit.
+  left->setMinimumWidth(520);
   layout->addWidget(split);
   connect(signal_, &QComboBox::currentIndexChanged, this, &ResultsPanel::plot_signal);
   clear();
