@@ -23,6 +23,8 @@ Canvas::Canvas(SceneController* controller, QWidget* parent)
   setAcceptDrops(true);
   setRenderHint(QPainter::Antialiasing);
   setDragMode(RubberBandDrag);
+  // Ctrl+wheel zooms about the point under the cursor.
+  setTransformationAnchor(AnchorUnderMouse);
   setBackgroundBrush(QColor(252, 252, 250));
   connect(controller_, &SceneController::document_changed, this, &Canvas::sync);
   connect(controller_, &SceneController::file_changed, this, [this] {
@@ -420,7 +422,29 @@ void Canvas::dropEvent(QDropEvent* e) {
   e->acceptProposedAction();
 }
 
+bool Canvas::find_block(const QString& text) {
+  // The first block whose name contains the text (case-insensitive), the exact name first.
+  BlockItem* found = block_item(text.toStdString());
+  for (auto it = blocks_.begin(); !found && it != blocks_.end(); ++it)
+    if (QString::fromStdString(it->first).contains(text, Qt::CaseInsensitive)) found = it->second;
+  if (!found || text.isEmpty()) {
+    emit message(tr("no block named like '%1' here").arg(text));
+    return false;
+  }
+  scene_.clearSelection();
+  found->setSelected(true);
+  centerOn(found);
+  emit message(tr("found %1").arg(q(found->name())));
+  return true;
+}
+
 void Canvas::mousePressEvent(QMouseEvent* e) {
+  if (e->button() == Qt::MiddleButton) {
+    // Pan: the diagram follows the mouse while the middle button is held.
+    pan_from_ = e->pos();
+    panning_ = true;
+    return;
+  }
   if (e->button() == Qt::LeftButton && at_scene_level()) {
     if (PortItem* p = port_at(e->pos())) {
       drag_from_ = p;
@@ -432,6 +456,13 @@ void Canvas::mousePressEvent(QMouseEvent* e) {
 }
 
 void Canvas::mouseMoveEvent(QMouseEvent* e) {
+  if (panning_) {
+    const QPoint d = e->pos() - pan_from_;
+    pan_from_ = e->pos();
+    horizontalScrollBar()->setValue(horizontalScrollBar()->value() - d.x());
+    verticalScrollBar()->setValue(verticalScrollBar()->value() - d.y());
+    return;
+  }
   if (!drag_from_) return QGraphicsView::mouseMoveEvent(e);
   const QPointF at = mapToScene(e->pos());
   const QPointF a = drag_from_->anchor();
@@ -453,6 +484,10 @@ void Canvas::mouseMoveEvent(QMouseEvent* e) {
 }
 
 void Canvas::mouseReleaseEvent(QMouseEvent* e) {
+  if (panning_ && e->button() == Qt::MiddleButton) {
+    panning_ = false;
+    return;
+  }
   if (!drag_from_) {
     QGraphicsView::mouseReleaseEvent(e);
     commit_moves();

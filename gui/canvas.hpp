@@ -41,6 +41,9 @@ class Canvas : public QGraphicsView {
   void set_notes(const std::map<std::string, QString>& notes);
   /// Fits the whole diagram in the view (never magnifying beyond natural size).
   void fit_all();
+  /// Selects and centres the block named `text` (or the first whose name contains it) at the
+  /// level shown; false when there is none.
+  bool find_block(const QString& text);
 
   /// Shows the inside of subsystem instance `block` of the level shown (a double-click on it);
   /// false when it is not an instance whose definition is known.
@@ -103,6 +106,8 @@ class Canvas : public QGraphicsView {
   QGraphicsPathItem* drag_wire_ = nullptr;
   QStringList level_;
   QString shown_file_;
+  bool panning_ = false;
+  QPoint pan_from_;
   std::set<std::string> all_ports_;  ///< blocks showing every port
 };
 

@@ -5,6 +5,7 @@
 #include <QDockWidget>
 #include <QFileDialog>
 #include <QFileInfo>
+#include <QLineEdit>
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QStatusBar>
@@ -106,6 +107,19 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   // Where the canvas is: the scene, or the subsystem instances opened; each entry goes back there.
   auto* where = addToolBar(tr("Level"));
   where->setObjectName("level_toolbar");
+  find_ = new QLineEdit;
+  find_->setObjectName("find_block");
+  find_->setPlaceholderText(tr("find block (Ctrl+F)"));
+  find_->setMaximumWidth(220);
+  where->addWidget(find_);
+  connect(find_, &QLineEdit::returnPressed, this, [this] { canvas_->find_block(find_->text().trimmed()); });
+  auto* find_action = new QAction(this);
+  find_action->setShortcut(QKeySequence::Find);
+  connect(find_action, &QAction::triggered, this, [this] {
+    find_->setFocus();
+    find_->selectAll();
+  });
+  addAction(find_action);
   breadcrumb_ = new QLabel;
   breadcrumb_->setTextFormat(Qt::RichText);
   where->addWidget(breadcrumb_);

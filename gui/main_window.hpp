@@ -4,6 +4,7 @@
 
 #include <QAction>
 #include <QLabel>
+#include <QLineEdit>
 #include <QMainWindow>
 #include <QProgressBar>
 
@@ -30,6 +31,7 @@ class MainWindow : public QMainWindow {
   ScenePanel* scene_panel() { return scene_panel_; }
   ResultsPanel* results() { return results_; }
   QLabel* breadcrumb() { return breadcrumb_; }
+  QLineEdit* find_field() { return find_; }
   /// The message shown in the status bar.
   QString status_text() const { return status_label_->text(); }
   RunWorker* worker() { return &worker_; }
@@ -68,6 +70,7 @@ class MainWindow : public QMainWindow {
   QAction* cancel_action_;
   QLabel* status_label_;
   QLabel* breadcrumb_;
+  QLineEdit* find_;
   QString last_error_;
 };
 

@@ -91,6 +91,38 @@ class GuiViews : public QObject {
     QVERIFY(blocks_outside_view(canvas).isEmpty());
   }
 
+  // Find: a name typed into the toolbar's field and Return select the block and bring it into
+  // view; the middle button drags the view.
+  void find_block_and_pan() {
+    MainWindow w;
+    w.resize(1400, 900);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.open_file(QString(DYDP_SCENARIOS_DIR) + "/fourposter_comfort.yaml", true));
+    Canvas* canvas = w.canvas();
+    canvas->resetTransform();  // natural size: the diagram is larger than the view
+    canvas->centerOn(canvas->block_item("rig"));
+    QApplication::processEvents();
+    const auto visible = [canvas](const char* block) {
+      return canvas->viewport()->rect().contains(
+          canvas->mapFromScene(canvas->block_item(block)->sceneBoundingRect().center()));
+    };
+    QVERIFY(!visible("comfort_wk"));
+    QTest::keyClicks(w.find_field(), "comfort_w");
+    QTest::keyClick(w.find_field(), Qt::Key_Return);
+    QVERIFY(visible("comfort_wk"));
+    QCOMPARE(canvas->selected_blocks(), QStringList{"comfort_wk"});
+    // Middle-button drag by 200 px to the right moves the diagram 200 px right in the view.
+    const QPoint before = canvas->mapFromScene(canvas->block_item("comfort_wk")->pos());
+    const QPoint at = canvas->viewport()->rect().center();
+    QTest::mousePress(canvas->viewport(), Qt::MiddleButton, {}, at);
+    QTest::mouseMove(canvas->viewport(), at + QPoint(100, 0));
+    QTest::mouseMove(canvas->viewport(), at + QPoint(200, 0));
+    QTest::mouseRelease(canvas->viewport(), Qt::MiddleButton, {}, at + QPoint(200, 0));
+    const QPoint after = canvas->mapFromScene(canvas->block_item("comfort_wk")->pos());
+    QCOMPARE(after - before, QPoint(200, 0));
+  }
+
   // fourposter_comfort: car, rig, objectives and four corner instances drawn as one block each;
   // a double-click opens corner_fl (its blocks and its ports as edge blocks, wired), the
   // breadcrumb's "scene" entry goes back.
