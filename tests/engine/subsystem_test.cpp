@@ -219,6 +219,23 @@ TEST_F(Subsystems, KeyGivenTwiceInsideTheSubsystemFile) {
   expect_error(e, (dir_ / "sub/oscillator.yaml").string(), 10, "force.frequency", "key given twice");
 }
 
+// Inline, a block written twice in a definition reads like one written twice in the scene.
+TEST_F(Subsystems, BlockGivenTwiceInAnInlineDefinition) {
+  const auto e = load_error(put("s.yaml", R"(scene: t
+time: {stop: 1.0, output_step: 0.1}
+subsystems:
+  pair:
+    outputs: {y: g.y}
+    blocks:
+      g: {type: source.constant, value: 1.0}
+      g: {type: source.constant, value: 2.0}
+blocks:
+  p: {type: subsystem.pair}
+outputs: [p.y]
+)"));
+  expect_error(e, (dir_ / "s.yaml").string(), 8, "g", "block defined twice (first at line 7)");
+}
+
 TEST_F(Subsystems, OutputPortNamingAMissingPortInsideTheSubsystem) {
   std::string osc = kOscillator;
   osc.replace(osc.find("position: body.x"), 16, "position: body.q");
