@@ -183,7 +183,7 @@ bool MainWindow::open_file(const QString& path, bool quiet) {
     status(last_error_);
     return false;
   }
-  results_->clear();
+  results_->forget_runs();
   canvas_->fit_all();
   status(tr("opened %1").arg(path));
   return true;

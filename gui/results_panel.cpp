@@ -26,9 +26,16 @@ QChartView* make_chart_view() {
   return view;
 }
 
-/// Replaces the chart's series by the given curves against t, with fitted axes.
-void set_curves(QChartView* view, const QString& title, const QString& y_title, const std::vector<double>& t,
-                const std::vector<std::pair<QString, std::vector<double>>>& curves) {
+/// One curve of a chart: values against its own time grid; dashed for the previous run.
+struct Curve {
+  QString name;
+  const std::vector<double>* t;
+  std::vector<double> v;
+  bool dashed = false;
+};
+
+/// Replaces the chart's series by the given curves, with fitted axes.
+void set_curves(QChartView* view, const QString& title, const QString& y_title, const std::vector<Curve>& curves) {
   QChart* chart = view->chart();
   chart->removeAllSeries();
   for (QAbstractAxis* a : chart->axes()) {
@@ -36,30 +43,38 @@ void set_curves(QChartView* view, const QString& title, const QString& y_title, 
     delete a;
   }
   chart->setTitle(title);
-  if (t.empty() || curves.empty()) return;
-  double lo = INFINITY, hi = -INFINITY;
+  if (curves.empty() || curves.front().t->empty()) return;
+  double lo = INFINITY, hi = -INFINITY, t0 = INFINITY, t1 = -INFINITY;
   auto* x = new QValueAxis;
   auto* y = new QValueAxis;
   x->setTitleText("t [s]");
   y->setTitleText(y_title);
-  x->setRange(t.front(), t.back());
   chart->addAxis(x, Qt::AlignBottom);
   chart->addAxis(y, Qt::AlignLeft);
-  for (const auto& [name, v] : curves) {
+  for (const Curve& c : curves) {
     auto* s = new QLineSeries;
-    s->setName(name);
+    s->setName(c.name);
     QList<QPointF> points;
-    points.reserve(static_cast<qsizetype>(t.size()));
-    for (size_t k = 0; k < t.size(); ++k) {
-      points.append({t[k], v[k]});
-      lo = std::min(lo, v[k]);
-      hi = std::max(hi, v[k]);
+    points.reserve(static_cast<qsizetype>(c.t->size()));
+    for (size_t k = 0; k < c.t->size() && k < c.v.size(); ++k) {
+      points.append({(*c.t)[k], c.v[k]});
+      lo = std::min(lo, c.v[k]);
+      hi = std::max(hi, c.v[k]);
     }
+    t0 = std::min(t0, c.t->front());
+    t1 = std::max(t1, c.t->back());
     s->replace(points);
     chart->addSeries(s);
     s->attachAxis(x);
     s->attachAxis(y);
+    if (c.dashed) {
+      QPen pen = s->pen();
+      pen.setStyle(Qt::DashLine);
+      pen.setColor(QColor(150, 150, 150));
+      s->setPen(pen);
+    }
   }
+  x->setRange(t0, t1);
   if (!(hi > lo)) {
     lo -= 1;
     hi += 1;
@@ -107,8 +122,13 @@ void ResultsPanel::clear() {
   objectives_->setColumnCount(4);
   objectives_->setHorizontalHeaderLabels({tr("objective"), tr("quantity"), tr("value"), tr("unit")});
   signal_->clear();
-  set_curves(value_chart_, tr("signal"), {}, {}, {});
-  set_curves(sens_chart_, tr("sensitivities"), {}, {}, {});
+  set_curves(value_chart_, tr("signal"), {}, {});
+  set_curves(sens_chart_, tr("sensitivities"), {}, {});
+}
+
+void ResultsPanel::forget_runs() {
+  clear();
+  previous_.reset();
 }
 
 QString ResultsPanel::parameter_unit(size_t d) const {
@@ -125,6 +145,8 @@ QString ResultsPanel::full_number(double v) { return QString::number(v, 'g', QLo
 
 void ResultsPanel::show_result(std::shared_ptr<const engine::RunResult> result,
                                std::shared_ptr<const engine::Diagram> diagram) {
+  // The run shown so far stays, dashed, for comparison with the new one.
+  if (result_) previous_ = result_;
   clear();
   result_ = std::move(result);
   diagram_ = std::move(diagram);
@@ -168,15 +190,23 @@ void ResultsPanel::plot_signal(int i) {
   for (size_t k = 0; k < n; ++k) v[k] = r.value(static_cast<int>(k), i);
   const QString name = q(r.signal_names[i]);
   const QString unit = signal_unit(i);
-  set_curves(value_chart_, name, unit.isEmpty() ? name : QString("%1 [%2]").arg(name, unit), r.t, {{name, v}});
-  std::vector<std::pair<QString, std::vector<double>>> sens;
+  std::vector<Curve> values = {{name, &r.t, std::move(v)}};
+  // The same signal of the previous run, when it has one.
+  const int j = previous_ ? previous_->signal_index(r.signal_names[i]) : -1;
+  if (j >= 0) {
+    std::vector<double> pv(previous_->t.size());
+    for (size_t k = 0; k < pv.size(); ++k) pv[k] = previous_->value(static_cast<int>(k), j);
+    values.push_back({name + tr(" (previous run)"), &previous_->t, std::move(pv), true});
+  }
+  set_curves(value_chart_, name, unit.isEmpty() ? name : QString("%1 [%2]").arg(name, unit), values);
+  std::vector<Curve> sens;
   if (!r.tangents.empty()) {
     for (size_t d = 0; d < r.sensitivity_names.size(); ++d) {
       std::vector<double> dv(n);
       for (size_t k = 0; k < n; ++k) dv[k] = r.tangent(static_cast<int>(k), static_cast<int>(d), i);
       const QString per = q(engine::unit_per(unit.toStdString(), parameter_unit(d).toStdString()));
-      sens.emplace_back(QString("d/d%1").arg(q(r.sensitivity_names[d])) + (per.isEmpty() ? "" : " [" + per + "]"),
-                        std::move(dv));
+      sens.push_back({QString("d/d%1").arg(q(r.sensitivity_names[d])) + (per.isEmpty() ? "" : " [" + per + "]"),
+                      &r.t, std::move(dv)});
     }
   }
   // The axis names the unit when all directions share it; else each curve's name carries its own.
@@ -186,7 +216,7 @@ void ResultsPanel::plot_signal(int i) {
     per_all = d == 0 || per == per_all ? per : QString("mixed");
   }
   set_curves(sens_chart_, tr("sensitivities of %1").arg(name),
-             QString("d(%1)/dp").arg(name) + (per_all.isEmpty() || per_all == "mixed" ? "" : " [" + per_all + "]"), r.t, sens);
+             QString("d(%1)/dp").arg(name) + (per_all.isEmpty() || per_all == "mixed" ? "" : " [" + per_all + "]"), sens);
   if (signal_->currentIndex() != i) {
     const QSignalBlocker block(signal_);
     signal_->setCurrentIndex(i);

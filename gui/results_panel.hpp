@@ -1,6 +1,6 @@
 // Results of the last run: the objectives table (psi and d(psi)/dp for every direction, one row
 // each, with full precision and units) and plots of a chosen logged signal over time with its
-// sensitivities, axes named with their units.
+// sensitivities, axes named with their units, the previous run's curve dashed beside it.
 #pragma once
 
 #include <QComboBox>
@@ -26,6 +26,8 @@ class ResultsPanel : public QWidget {
   void show_result(std::shared_ptr<const engine::RunResult> result,
                    std::shared_ptr<const engine::Diagram> diagram = nullptr);
   void clear();
+  /// Clears and forgets the previous run too (another scene opened).
+  void forget_runs();
   QTableWidget* objectives() { return objectives_; }
   /// Plots signal i (index into the result's logged signals).
   void plot_signal(int i);
@@ -41,6 +43,7 @@ class ResultsPanel : public QWidget {
   QString signal_unit(int signal) const;
 
   std::shared_ptr<const engine::RunResult> result_;
+  std::shared_ptr<const engine::RunResult> previous_;  ///< the run shown before, for comparison
   std::shared_ptr<const engine::Diagram> diagram_;
   QTableWidget* objectives_;
   QComboBox* signal_;

@@ -1,6 +1,8 @@
 // Scenes built in the GUI by the calls a drag makes (palette drop, port-to-port wire, property
 // edits), saved, reopened and run in the worker thread; refusals with reasons; undo and redo;
 // validation errors marked on their block; cancelling a run.
+#include <QChart>
+#include <QChartView>
 #include <QMimeData>
 #include <QSignalSpy>
 #include <QTemporaryDir>
@@ -93,6 +95,10 @@ class GuiEditing : public QObject {
     const RunOutcome edited = run_and_wait(w);
     QVERIFY(edited.status == RunOutcome::Status::finished);
     QVERIFY(std::abs(edited.result->objectives.front().value - 8.0) < 1e-6);
+    // The plot keeps the previous run beside the new one, for comparison.
+    const QList<QAbstractSeries*> series = w.results()->value_chart()->chart()->series();
+    QCOMPARE(series.size(), 2);
+    QVERIFY(series.at(1)->name().endsWith("(previous run)"));
   }
 
   void wires_with_mismatches_are_refused_with_the_reason() {
