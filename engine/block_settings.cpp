@@ -23,6 +23,11 @@ int BlockSettings::line(const std::string& name) const {
   return it == values_.end() || it->second.line <= 0 ? line_ : it->second.line;
 }
 
+const std::string& BlockSettings::file(const std::string& name) const {
+  const auto it = values_.find(name);
+  return it == values_.end() || it->second.file.empty() ? file_ : it->second.file;
+}
+
 const BlockSettings::Value& BlockSettings::get(const std::string& name) const {
   auto it = values_.find(name);
   if (it == values_.end())
@@ -32,7 +37,7 @@ const BlockSettings::Value& BlockSettings::get(const std::string& name) const {
 
 void BlockSettings::fail(const std::string& name, const std::string& message) const {
   auto it = values_.find(name);
-  throw InputError(file_, it == values_.end() ? line_ : it->second.line, block_ + "." + name,
+  throw InputError(file(name), it == values_.end() ? line_ : it->second.line, block_ + "." + name,
                    message);
 }
 
@@ -72,7 +77,7 @@ std::vector<std::string> BlockSettings::texts(const std::string& name) const {
 std::string BlockSettings::path(const std::string& name) const {
   std::filesystem::path p(text(name));
   if (p.is_absolute()) return p.string();
-  return (std::filesystem::path(file_).parent_path() / p).lexically_normal().string();
+  return (std::filesystem::path(file(name)).parent_path() / p).lexically_normal().string();
 }
 
 }  // namespace dydp::engine

@@ -21,6 +21,7 @@ class BlockSettings {
     std::vector<std::string> items;  ///< one item for a scalar, several for a list
     bool is_list = false;
     int line = 0;
+    std::string file;  ///< where it was written when not the block's file (a subsystem instance's value)
   };
 
   BlockSettings(std::string block_name, std::string file, int block_line)
@@ -42,6 +43,8 @@ class BlockSettings {
   [[noreturn]] void fail(const std::string& name, const std::string& message) const;
   /// Line where the setting was written (the block's line for a default or an unknown name).
   int line(const std::string& name) const;
+  /// File of line(name).
+  const std::string& file(const std::string& name) const;
 
   const std::string& block_name() const { return block_; }
   const std::string& file() const { return file_; }

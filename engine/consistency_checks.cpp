@@ -1,22 +1,28 @@
 #include "engine/consistency_checks.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "engine/errors.hpp"
 
 namespace dydp::engine {
 namespace {
 
-/// Where the field a check names was written: a parameter's value, a setting, else the block.
-int line_of_field(const Node& n, const std::string& field) {
+/// Where the field a check names was written (file, line): a parameter's value, a setting,
+/// else the block. `file`: the scene's, for a block written in it.
+std::pair<std::string, int> where_field(const std::string& file, const Node& n, const std::string& field) {
+  const std::string& block_file = n.file.empty() ? file : n.file;
   const auto& params = n.type->parameters;
   const auto ps = std::find_if(params.begin(), params.end(),
                                [&](const ParamSpec& s) { return s.name == field; });
   if (ps != params.end()) {
-    const int line = n.p_line[ps - params.begin()];
-    return line > 0 ? line : n.line;
+    const size_t j = static_cast<size_t>(ps - params.begin());
+    const int line = n.p_line[j];
+    if (line <= 0) return {block_file, n.line};
+    return {j < n.p_file.size() && !n.p_file[j].empty() ? n.p_file[j] : block_file, line};
   }
-  return n.settings ? n.settings->line(field) : n.line;
+  if (!n.settings) return {block_file, n.line};
+  return {n.settings->file(field), n.settings->line(field)};
 }
 
 }  // namespace
@@ -28,7 +34,8 @@ void check_block(const std::string& file, const Node& n, const std::vector<doubl
   for (const BlockCheck& check : n.type->checks) {
     const std::optional<std::string> why = check.broken(in);
     if (!why) continue;
-    const InputError e(file, line_of_field(n, check.field), n.name + "." + check.field, *why);
+    const auto [at_file, at_line] = where_field(file, n, check.field);
+    const InputError e(at_file, at_line, n.name + "." + check.field, *why);
     if (check.severity == BlockCheck::Severity::error) throw e;
     if (warnings) warnings->push_back(e.what());
   }

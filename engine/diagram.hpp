@@ -48,8 +48,9 @@ struct SceneParameter {
 };
 
 struct Node {
-  std::string name;
+  std::string name;                 ///< inside a subsystem instance: `corner_fl.damper`
   const BlockType* type = nullptr;
+  std::string file;                 ///< where the block is written (a subsystem's file); empty: the scene
   int line = 0;
   std::unique_ptr<Block> block;
   const Objective* objective = nullptr;  ///< the block as an objective, or null
@@ -63,10 +64,17 @@ struct Node {
   /// Nominal magnitude of each state (the block's, with the scene's `nominal:` entries);
   /// empty for nodes not read from a scene: the block's declared values.
   std::vector<double> state_nominal;
+  std::vector<std::string> p_file;  ///< the file of p_line[j] (an instance's value: the including file); empty: `file`
   std::vector<int> input_source;    ///< signal offset of the output feeding input k
   std::vector<int> output_offset;   ///< signal offset of output k
   int state_offset = 0;
   int quad_offset = 0;
+
+  /// The file where p[j] was written (`scene_file` when that is the scene itself).
+  const std::string& parameter_file(size_t j, const std::string& scene_file) const {
+    if (j < p_file.size() && !p_file[j].empty()) return p_file[j];
+    return file.empty() ? scene_file : file;
+  }
 };
 
 /// One call of a block's outputs (and of their tangents) in the value and tangent passes.

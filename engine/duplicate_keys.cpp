@@ -40,9 +40,12 @@ void walk(const YAML::Node& node, const std::string& path, bool is_block_list,
       throw InputError(file, line, field,
                        what + " (first at line " + std::to_string(seen->second) + ")");
     }
-    const bool top = path.empty() && !is_block_list;
-    walk(kv.second, is_block_list || (top && key == "blocks") ? key : join(path, key),
-         top && key == "blocks", file, visited);
+    // The scene's top level and each inline subsystem definition (`subsystems.NAME`) hold a
+    // `blocks:` mapping whose keys are block names.
+    const bool top = !is_block_list && (path.empty() || (path.rfind("subsystems.", 0) == 0 &&
+                                                         path.find('.', 11) == std::string::npos));
+    const bool blocks = top && key == "blocks";
+    walk(kv.second, is_block_list || blocks ? key : join(path, key), blocks, file, visited);
   }
 }
 

@@ -7,29 +7,18 @@
 #include "engine/errors.hpp"
 
 namespace dydp::engine {
-namespace {
-
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t");
-  const auto e = s.find_last_not_of(" \t");
-  return b == std::string::npos ? "" : s.substr(b, e - b + 1);
-}
-
-}  // namespace
-
 void GraphBuilder::add_block(Node node) {
   index_[node.name] = static_cast<int>(nodes_.size());
   nodes_.push_back(std::move(node));
 }
 
-GraphBuilder::PortRef GraphBuilder::resolve(const std::string& text, bool input, int line) const {
-  const auto dot = text.find('.');
-  const std::string block = text.substr(0, dot);
+GraphBuilder::PortRef GraphBuilder::resolve(const std::string& block, const std::string& port,
+                                            bool input, int line, const std::string& file) const {
+  const std::string text = port.empty() ? block : block + "." + port;
   auto it = index_.find(block);
-  if (it == index_.end()) throw InputError(file_, line, text, "unknown block '" + block + "'");
+  if (it == index_.end()) throw InputError(file_or_scene(file), line, text, "unknown block '" + block + "'");
   PortRef ref{it->second, -1};
-  if (dot == std::string::npos) return ref;
-  const std::string port = text.substr(dot + 1);
+  if (port.empty()) return ref;
   const Block& b = *nodes_[ref.node].block;
   const auto& ports = input ? b.inputs() : b.outputs();
   for (size_t k = 0; k < ports.size(); ++k)
@@ -37,7 +26,7 @@ GraphBuilder::PortRef GraphBuilder::resolve(const std::string& text, bool input,
   if (ref.port < 0) {
     std::string known;
     for (const auto& p : ports) known += " " + p.name;
-    throw InputError(file_, line, text,
+    throw InputError(file_or_scene(file), line, text,
                      std::string("block '") + block + "' has no " + (input ? "input" : "output") +
                          " port '" + port + "' (" + (input ? "inputs" : "outputs") + ":" +
                          (known.empty() ? " none" : known) + ")");
@@ -45,29 +34,34 @@ GraphBuilder::PortRef GraphBuilder::resolve(const std::string& text, bool input,
   return ref;
 }
 
-void GraphBuilder::connect(const std::string& text, int line) {
-  const auto arrow = text.find("->");
-  if (arrow == std::string::npos)
-    throw InputError(file_, line, "connections", "expected 'block.port -> block.port', got '" + text + "'");
-  const std::string from = trim(text.substr(0, arrow)), to = trim(text.substr(arrow + 2));
-  if (from.find('.') == std::string::npos || to.find('.') == std::string::npos)
-    throw InputError(file_, line, "connections", "both ends need block.port, got '" + text + "'");
-  Edge e{resolve(from, false, line), resolve(to, true, line), line};
+void GraphBuilder::check_port(const std::string& block, const std::string& port, bool input,
+                              int line, const std::string& file) const {
+  resolve(block, port, input, line, file);
+}
+
+void GraphBuilder::connect(const std::string& src_block, const std::string& src_port,
+                           const std::string& dst_block, const std::string& dst_port, int line,
+                           const std::string& file) {
+  const std::string from = src_block + "." + src_port, to = dst_block + "." + dst_port;
+  Edge e{resolve(src_block, src_port, false, line, file), resolve(dst_block, dst_port, true, line, file),
+         line, file_or_scene(file)};
   const int w_src = nodes_[e.src.node].block->outputs()[e.src.port].width;
   const int w_dst = nodes_[e.dst.node].block->inputs()[e.dst.port].width;
   if (w_src != w_dst)
-    throw InputError(file_, line, to,
+    throw InputError(e.file, line, to,
                      "width mismatch: " + from + " has width " + std::to_string(w_src) + ", " + to +
                          " expects " + std::to_string(w_dst));
   for (const Edge& other : edges_)
     if (other.dst.node == e.dst.node && other.dst.port == e.dst.port)
-      throw InputError(file_, line, to,
-                       "input driven twice (also connected at line " + std::to_string(other.line) + ")");
-  edges_.push_back(e);
+      throw InputError(e.file, line, to,
+                       "input driven twice (also connected at " +
+                           (other.file == e.file ? "line " : other.file + ":") + std::to_string(other.line) + ")");
+  edges_.push_back(std::move(e));
 }
 
-void GraphBuilder::request_output(const std::string& text, int line) {
-  requested_.emplace_back(resolve(trim(text), false, line), line);
+void GraphBuilder::request_output(const std::string& block, const std::string& port, int line,
+                                  const std::string& file, const std::string& shown_as) {
+  requested_.push_back({resolve(block, port, false, line, file), line, shown_as});
 }
 
 std::vector<OutputStep> GraphBuilder::schedule_or_report_loop(const std::vector<bool>& keep) const {
@@ -110,14 +104,15 @@ std::vector<OutputStep> GraphBuilder::schedule_or_report_loop(const std::vector<
 
   const int ns = static_cast<int>(steps.size());
   std::vector<int> indegree(ns, 0);
-  std::vector<std::vector<std::pair<int, int>>> next(ns);  // (step, line of the connection)
-  for (const Edge& e : edges_) {
+  std::vector<std::vector<std::pair<int, int>>> next(ns);  // (step, index of the connection)
+  for (size_t ei = 0; ei < edges_.size(); ++ei) {
+    const Edge& e = edges_[ei];
     if (!keep[e.src.node] || !keep[e.dst.node]) continue;
     const int from = step_of_output[e.src.node][e.src.port];
     for (int to : steps_of_node[e.dst.node]) {
       const auto& reads = steps[to].reads;
       if (!std::binary_search(reads.begin(), reads.end(), e.dst.port)) continue;
-      next[from].emplace_back(to, e.line);
+      next[from].emplace_back(to, static_cast<int>(ei));
       ++indegree[to];
     }
   }
@@ -129,7 +124,7 @@ std::vector<OutputStep> GraphBuilder::schedule_or_report_loop(const std::vector<
     const int s = ready.top();
     ready.pop();
     order.push_back(s);
-    for (const auto& [t, line] : next[s])
+    for (const auto& [t, edge] : next[s])
       if (--indegree[t] == 0) ready.push(t);
   }
   if (static_cast<int>(order.size()) == ns) {
@@ -152,7 +147,7 @@ std::vector<OutputStep> GraphBuilder::schedule_or_report_loop(const std::vector<
   // Some steps remain, each with a remaining predecessor: walk predecessors until one repeats.
   std::vector<std::vector<std::pair<int, int>>> prev(ns);
   for (int s = 0; s < ns; ++s)
-    for (const auto& [t, line] : next[s]) prev[t].emplace_back(s, line);
+    for (const auto& [t, edge] : next[s]) prev[t].emplace_back(s, edge);
   int at = -1;
   for (int s = 0; s < ns && at < 0; ++s)
     if (indegree[s] > 0) at = s;
@@ -161,21 +156,26 @@ std::vector<OutputStep> GraphBuilder::schedule_or_report_loop(const std::vector<
   while (pos[at] < 0) {
     pos[at] = static_cast<int>(path.size());
     path.push_back(at);
-    for (const auto& [s, line] : prev[at])
+    for (const auto& [s, edge] : prev[at])
       if (indegree[s] > 0) { at = s; break; }
   }
   std::vector<int> cycle(path.begin() + pos[at], path.end());
   std::reverse(cycle.begin(), cycle.end());  // now in signal-flow order
+  // Named at the first connection of the loop as written (the scene's own file first).
   std::string names;
-  int line = 0;
+  const Edge* at_edge = nullptr;
+  const auto earlier = [&](const Edge& a, const Edge& b) {
+    if ((a.file == file_) != (b.file == file_)) return a.file == file_;
+    return a.file != b.file ? a.file < b.file : a.line < b.line;
+  };
   for (size_t k = 0; k < cycle.size(); ++k) {
     names += nodes_[steps[cycle[k]].node].name + " -> ";
     const int to = cycle[(k + 1) % cycle.size()];
-    for (const auto& [t, l] : next[cycle[k]])
-      if (t == to && (line == 0 || l < line)) line = l;
+    for (const auto& [t, edge] : next[cycle[k]])
+      if (t == to && (!at_edge || earlier(edges_[edge], *at_edge))) at_edge = &edges_[edge];
   }
   names += nodes_[steps[cycle.front()].node].name;
-  throw InputError(file_, line, "connections",
+  throw InputError(at_edge ? at_edge->file : file_, at_edge ? at_edge->line : 0, "connections",
                    "algebraic loop (a cycle through direct feedthrough, no state to break it): " + names);
 }
 
@@ -189,7 +189,7 @@ void GraphBuilder::build(Diagram& d) {
         return e.dst.node == i && e.dst.port == static_cast<int>(k);
       });
       if (!driven)
-        throw InputError(file_, nodes_[i].line, nodes_[i].name + "." + inputs[k].name,
+        throw InputError(file_or_scene(nodes_[i].file), nodes_[i].line, nodes_[i].name + "." + inputs[k].name,
                          "input is not connected");
     }
   }
@@ -197,7 +197,7 @@ void GraphBuilder::build(Diagram& d) {
   // Keep what the requested outputs need, following every connection backwards.
   std::vector<bool> keep(n, false);
   std::vector<int> stack;
-  for (const auto& [ref, line] : requested_) stack.push_back(ref.node);
+  for (const Request& r : requested_) stack.push_back(r.ref.node);
   while (!stack.empty()) {
     const int i = stack.back();
     stack.pop_back();
@@ -240,7 +240,7 @@ void GraphBuilder::build(Diagram& d) {
     dst.input_source[e.dst.port] = d.nodes[new_index[e.src.node]].output_offset[e.src.port];
   }
 
-  for (const auto& [ref, line] : requested_) {
+  for (const auto& [ref, line, shown_as] : requested_) {
     const Node& node = d.nodes[new_index[ref.node]];
     if (ref.port < 0 && node.objective) {
       d.objectives.push_back(new_index[ref.node]);
@@ -249,7 +249,7 @@ void GraphBuilder::build(Diagram& d) {
     const auto& ports = node.block->outputs();
     for (size_t k = 0; k < ports.size(); ++k) {
       if (ref.port >= 0 && ref.port != static_cast<int>(k)) continue;
-      const std::string base = node.name + "." + ports[k].name;
+      const std::string base = ref.port >= 0 && !shown_as.empty() ? shown_as : node.name + "." + ports[k].name;
       for (int c = 0; c < ports[k].width; ++c)
         d.logged.push_back({ports[k].width == 1 ? base : base + "[" + std::to_string(c) + "]",
                             node.output_offset[k] + c});

@@ -4,31 +4,22 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
-#include <limits>
-#include <set>
 
+#include "engine/block_reader.hpp"
 #include "engine/consistency_checks.hpp"
 #include "engine/diagram.hpp"
 #include "engine/duplicate_keys.hpp"
 #include "engine/errors.hpp"
 #include "engine/graph_builder.hpp"
-#include "engine/nominal_overrides.hpp"
+#include "engine/scene_flattener.hpp"
 #include "engine/scene_relations.hpp"
+#include "engine/subsystem_definition.hpp"
 
 namespace dydp::engine {
 namespace {
 
 int line_of(const YAML::Node& n) { return n.Mark().is_null() ? 0 : n.Mark().line + 1; }
-
-/// A number, not zero as written, so small that it is denormal or zero as a double (1e-320).
-bool underflows(const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  return end == text.c_str() + text.size() && std::fabs(v) < std::numeric_limits<double>::min() &&
-         text.find_first_of("123456789") < text.find_first_of("eE");
-}
 
 class SceneReader {
  public:
@@ -44,14 +35,7 @@ class SceneReader {
 
   double number(const YAML::Node& n, const std::string& field) const {
     if (!n.IsScalar()) fail(n, field, "expected a number");
-    double v = 0;
-    if (!parse_number(n.Scalar(), v)) {
-      if (underflows(n.Scalar()))
-        fail(n, field, "value " + n.Scalar() + " underflows (denormal or zero as a double, below " +
-                           format_number(std::numeric_limits<double>::min()) + ")");
-      fail(n, field, "malformed number '" + n.Scalar() + "'");
-    }
-    return v;
+    return scene_number(n.Scalar(), file_, line_of(n), field);
   }
 
   std::string text(const YAML::Node& n, const std::string& field) const {
@@ -157,99 +141,6 @@ void read_parameters(const SceneReader& r, const YAML::Node& n, Diagram& d) {
   }
 }
 
-/// One block of the scene: parameters resolved, settings collected, instance made.
-Node read_block(const SceneReader& r, const YAML::Node& key, const YAML::Node& body,
-                const Diagram& d, const std::vector<std::pair<std::string, std::string>>& forced,
-                std::vector<std::string>& warnings) {
-  Node node;
-  node.name = key.Scalar();
-  node.line = line_of(key);
-  if (node.name.empty() || node.name.find_first_of(". ") != std::string::npos)
-    r.fail(key, "blocks", "block name '" + node.name + "' must be non-empty, without '.' or spaces");
-  if (!body.IsMap() || !body["type"]) r.fail(key, node.name + ".type", "missing block type");
-  const std::string type_name = r.text(body["type"], node.name + ".type");
-  node.type = Registry::global().find(type_name);
-  if (!node.type)
-    r.fail(body["type"], node.name + ".type", "unknown block type '" + type_name + "'");
-  const BlockType& type = *node.type;
-
-  BlockSettings settings(node.name, r.file(), node.line);
-  std::set<std::string> seen;
-  for (auto kv : body) {
-    const std::string k = kv.first.Scalar();
-    const std::string field = node.name + "." + k;
-    if (k == "type" || k == "nominal") continue;
-    seen.insert(k);
-    auto ps = std::find_if(type.parameters.begin(), type.parameters.end(),
-                           [&](const ParamSpec& s) { return s.name == k; });
-    auto ss = std::find_if(type.settings.begin(), type.settings.end(),
-                           [&](const SettingSpec& s) { return s.name == k; });
-    if (ps == type.parameters.end() && ss == type.settings.end()) {
-      std::string known;
-      for (const auto& s : type.parameters) known += " " + s.name;
-      for (const auto& s : type.settings) known += " " + s.name;
-      r.fail(kv.first, field, "unknown parameter of " + type_name + " (known:" + known + ")");
-    }
-    if (ss != type.settings.end()) {
-      BlockSettings::Value v;
-      v.line = line_of(kv.first);
-      if (kv.second.IsSequence()) {
-        v.is_list = true;
-        for (auto item : kv.second) v.items.push_back(r.text(item, field));
-      } else {
-        v.items.push_back(r.text(kv.second, field));
-      }
-      settings.set(k, std::move(v));
-    }
-  }
-  // Not a structured binding: clang 14 (the fuzz build) cannot capture one in the lambda.
-  for (const auto& setting : forced)
-    if (std::any_of(type.settings.begin(), type.settings.end(),
-                    [&](const SettingSpec& s) { return s.name == setting.first; }))
-      settings.set(setting.first, {{setting.second}, false, node.line});
-  for (const SettingSpec& s : type.settings) {
-    if (settings.has(s.name)) continue;
-    if (s.required) r.fail(key, node.name + "." + s.name, "required setting is missing");
-    settings.set(s.name, {{s.default_value}, false, node.line});
-  }
-
-  for (const ParamSpec& s : type.parameters) {
-    const std::string field = node.name + "." + s.name;
-    const YAML::Node v = body[s.name];
-    double value = s.default_value;
-    int scene = -1;
-    int line = 0;
-    if (v) {
-      line = line_of(v);
-      const std::string text = r.text(v, field);
-      if (!text.empty() && text[0] == '$') {
-        scene = d.find_parameter(text.substr(1));
-        if (scene < 0) r.fail(v, field, "unknown scene parameter '" + text + "'");
-        value = d.parameters[scene].value;
-      } else {
-        value = r.number(v, field);
-      }
-    } else if (s.required) {
-      r.fail(key, field, "required parameter is missing");
-    }
-    if (value < s.lower || value > s.upper)
-      r.fail(v ? line : node.line, field,
-             "value " + format_number(value) + " outside [" + format_number(s.lower) + ", " +
-                 format_number(s.upper) + "]" + (s.unit.empty() ? "" : " " + s.unit));
-    node.p.push_back(value);
-    node.p_scene.push_back(scene);
-    node.p_line.push_back(line);
-  }
-  node.block = type.make(settings);
-  node.state_nominal = body["nominal"]
-                           ? read_nominal_overrides(r.file(), node.name, body["nominal"], *node.block)
-                           : node.block->state_nominals();
-  node.objective = dynamic_cast<const Objective*>(node.block.get());
-  node.settings = std::make_shared<const BlockSettings>(std::move(settings));
-  check_block(r.file(), node, node.p, d.time, &warnings);
-  return node;
-}
-
 }  // namespace
 
 Diagram load_scene(const std::string& path,
@@ -270,7 +161,8 @@ Diagram load_scene(const std::string& path,
   if (!root.IsMap()) throw InputError(path, 1, "", "a scene is a YAML mapping");
   refuse_duplicate_keys(root, path);
   r.allow_keys(root, "", {"scene", "description", "time", "solver", "parameters",
-                               "sensitivities", "blocks", "connections", "outputs", "layout"});
+                               "sensitivities", "subsystems", "blocks", "connections", "outputs",
+                          "layout"});
 
   Diagram d;
   d.file = path;
@@ -303,14 +195,15 @@ Diagram load_scene(const std::string& path,
     }
   }
 
+  SubsystemLibrary library;
+  read_subsystem_section(root["subsystems"], path, library);
+
   const YAML::Node blocks = root["blocks"];
   if (!blocks || !blocks.IsMap() || blocks.size() == 0)
     r.fail(blocks ? blocks : root, "blocks", "a scene needs a mapping of blocks");
   GraphBuilder graph(path);
-  for (auto kv : blocks) {
-    if (graph.has_block(kv.first.Scalar())) r.fail(kv.first, kv.first.Scalar(), "block defined twice");
-    graph.add_block(read_block(r, kv.first, kv.second, d, setting_overrides, d.warnings));
-  }
+  SceneFlattener flat(d, graph, setting_overrides, d.warnings);
+  flat.add_scene(path, library, blocks, root["connections"]);
 
   // Sensitivity directions must only reach parameters the blocks can differentiate.
   for (const Node& n : graph.blocks())
@@ -318,18 +211,14 @@ Diagram load_scene(const std::string& path,
       if (n.p_scene[j] >= 0 && !n.type->parameters[j].differentiable &&
           std::find(d.sensitivities.begin(), d.sensitivities.end(), n.p_scene[j]) !=
               d.sensitivities.end())
-        r.fail(n.p_line[j], n.name + "." + n.type->parameters[j].name,
-               "not differentiable, cannot be driven by sensitivity parameter '" +
-                   d.parameters[n.p_scene[j]].name + "'");
+        throw InputError(n.parameter_file(j, path), n.p_line[j], n.name + "." + n.type->parameters[j].name,
+                         "not differentiable, cannot be driven by sensitivity parameter '" +
+                             d.parameters[n.p_scene[j]].name + "'");
 
-  if (const YAML::Node c = root["connections"]) {
-    if (!c.IsSequence()) r.fail(c, "connections", "expected a list of 'block.port -> block.port'");
-    for (auto item : c) graph.connect(r.text(item, "connections"), line_of(item));
-  }
   const YAML::Node outputs = root["outputs"];
   if (!outputs || !outputs.IsSequence() || outputs.size() == 0)
     r.fail(outputs ? outputs : root, "outputs", "a scene needs a list of outputs");
-  for (auto item : outputs) graph.request_output(r.text(item, "outputs"), line_of(item));
+  for (auto item : outputs) flat.request_output(r.text(item, "outputs"), path, line_of(item));
 
   graph.build(d);
   return d;
@@ -373,7 +262,7 @@ void Diagram::set_parameter(int index, double value, bool check_range) {
       if (n.p_scene[j] == index) {
         const ParamSpec& s = n.type->parameters[j];
         if (value < s.lower || value > s.upper)
-          throw InputError(file, n.p_line[j], n.name + "." + s.name,
+          throw InputError(n.parameter_file(j, file), n.p_line[j], n.name + "." + s.name,
                            "value " + format_number(value) + " (from $" + sp.name +
                                ") outside its bounds");
       }

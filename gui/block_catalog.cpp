@@ -13,12 +13,12 @@ BlockPorts ports_of(const engine::BlockType& type, const DocBlock& block) {
   engine::BlockSettings settings(block.name, "", 0);
   for (const engine::SettingSpec& s : type.settings) {
     if (const SceneValue* v = block.find(s.name)) {
-      settings.set(s.name, {v->items, v->is_list, 0});
+      settings.set(s.name, {v->items, v->is_list, 0, {}});
     } else if (s.required) {
       out.error = "setting '" + s.name + "' is required (" + s.description + ")";
       return out;
     } else {
-      settings.set(s.name, {{s.default_value}, false, 0});
+      settings.set(s.name, {{s.default_value}, false, 0, {}});
     }
   }
   try {

@@ -5,7 +5,10 @@
 #include <QMimeData>
 #include <QScrollBar>
 #include <QWheelEvent>
+#include <algorithm>
 #include <set>
+
+#include "gui/subsystem_ports.hpp"
 
 namespace dydp::gui {
 namespace {
@@ -20,10 +23,17 @@ Canvas::Canvas(SceneController* controller, QWidget* parent)
   setAcceptDrops(true);
   setRenderHint(QPainter::Antialiasing);
   setDragMode(RubberBandDrag);
+  // Ctrl+wheel zooms about the point under the cursor.
+  setTransformationAnchor(AnchorUnderMouse);
   setBackgroundBrush(QColor(252, 252, 250));
-  scene_.setSceneRect(-2000, -2000, 6000, 6000);
   connect(controller_, &SceneController::document_changed, this, &Canvas::sync);
+  connect(controller_, &SceneController::file_changed, this, [this] {
+    // Another scene (or a new one): start at its top.
+    if (shown_file_ != controller_->file_path() && !level_.isEmpty()) close_subsystem(static_cast<int>(level_.size()));
+    shown_file_ = controller_->file_path();
+  });
   connect(&scene_, &QGraphicsScene::selectionChanged, this, [this] {
+    if (!at_scene_level()) return;  // inside a subsystem: no block of the scene is selected
     const QStringList sel = selected_blocks();
     emit selection_changed(sel.size() == 1 ? sel.front() : QString());
   });
@@ -36,12 +46,154 @@ BlockItem* Canvas::block_item(const std::string& name) const {
 }
 
 void Canvas::sync() {
+  View view;
+  if (!make_view(view)) {
+    // The instance shown is gone (undo, rename): back to the scene.
+    level_.clear();
+    emit level_changed(level_);
+    make_view(view);
+  }
+  draw(view);
+}
+
+namespace {
+
+std::string summary_of(const SceneDocument& doc, const DocBlock& b) {
+  if (const DocSubsystem* def = doc.subsystem_of(b))
+    return "subsystem " + def->name + (def->description.empty() ? "" : ": " + def->description) +
+           " (double-click to open)";
+  const engine::BlockType* type = engine::Registry::global().find(b.type);
+  return type ? type->summary : "unknown block type";
+}
+
+BlockPorts ports_in(const SceneDocument& doc, const DocBlock& bound) {
+  if (doc.subsystem_of(bound)) return instance_ports(doc, bound);
+  const engine::BlockType* type = engine::Registry::global().find(bound.type);
+  if (type) return ports_of(*type, bound);
+  BlockPorts none;
+  none.error = "unknown block type '" + bound.type + "'";
+  return none;
+}
+
+engine::PortDecl port_named(const std::vector<engine::PortDecl>& ports, const std::string& name) {
+  for (const auto& p : ports)
+    if (p.name == name) return p;
+  engine::PortDecl p;
+  p.name = name;
+  return p;
+}
+
+}  // namespace
+
+bool Canvas::make_view(View& v) const {
   const SceneDocument& doc = controller_->document();
+  if (level_.isEmpty()) {
+    v.blocks = doc.blocks;
+    v.connections = doc.connections;
+    v.outputs = doc.outputs;
+    for (const DocBlock& b : doc.blocks) {
+      v.ports[b.name] = controller_->ports(b.name);
+      v.summaries[b.name] = summary_of(doc, b);
+    }
+    return true;
+  }
+  // Walk down the instances opened: each with its values bound as the engine binds them.
+  const DocBlock* top = doc.find_block(level_.front().toStdString());
+  if (!top) return false;
+  DocBlock instance = *top;
+  const DocSubsystem* def = doc.subsystem_of(instance);
+  for (qsizetype i = 1; def && def->error.empty() && i < level_.size(); ++i) {
+    const DocBlock* inner = def->find_block(level_[i].toStdString());
+    if (!inner) return false;
+    instance = bound_block(*def, instance, *inner);
+    def = doc.subsystem_of(instance);
+  }
+  if (!def || !def->error.empty()) return false;
+  double left = 0, right = 0, topmost = 0;
+  bool first = true;
+  for (const DocBlock& b : def->blocks) {
+    v.blocks.push_back(b);  // shown as written inside: `$stiffness`, not the instance's value
+    const DocBlock bound = bound_block(*def, instance, b);
+    v.ports[b.name] = ports_in(doc, bound);
+    v.summaries[b.name] = summary_of(doc, bound);
+    left = first ? b.x : std::min(left, b.x);
+    right = first ? b.x : std::max(right, b.x);
+    topmost = first ? b.y : std::min(topmost, b.y);
+    first = false;
+  }
+  v.connections = def->connections;
+  // The instance's own ports as blocks at the edges: inputs left of the inside, outputs right.
+  const BlockPorts outer = instance_ports(doc, instance);
+  int row = 0;
+  for (const auto& [port, targets] : def->inputs) {
+    DocBlock pb;
+    pb.name = "in " + port;
+    pb.x = left - 300;
+    pb.y = topmost + 90 * row++;
+    pb.placed = true;
+    BlockPorts pp;
+    pp.outputs.push_back(port_named(outer.inputs, port));
+    v.ports[pb.name] = pp;
+    v.summaries[pb.name] = "input port " + port + " of subsystem " + def->name;
+    for (const std::string& t : targets) {
+      DocConnection c;
+      c.from = {pb.name, port};
+      if (PortRef::parse(t, c.to)) v.connections.push_back(c);
+    }
+    v.blocks.push_back(pb);
+  }
+  row = 0;
+  for (const auto& [port, source] : def->outputs) {
+    DocBlock pb;
+    pb.name = "out " + port;
+    pb.x = right + 300;
+    pb.y = topmost + 90 * row++;
+    pb.placed = true;
+    BlockPorts pp;
+    pp.inputs.push_back(port_named(outer.outputs, port));
+    v.ports[pb.name] = pp;
+    v.summaries[pb.name] = "output port " + port + " of subsystem " + def->name;
+    DocConnection c;
+    c.to = {pb.name, port};
+    if (PortRef::parse(source, c.from)) v.connections.push_back(c);
+    v.blocks.push_back(pb);
+  }
+  return true;
+}
+
+void Canvas::toggle_all_ports(const QString& block) {
+  const std::string name = block.toStdString();
+  if (!all_ports_.erase(name)) all_ports_.insert(name);
+  sync();
+}
+
+BlockPorts Canvas::shown_ports(const View& view, const std::string& block) const {
+  // A block with very many ports (a whole car) shows those in use; the rest on request.
+  BlockPorts ports = view.ports.at(block);
+  if (ports.inputs.size() + ports.outputs.size() <= kPortsShownAll || all_ports_.count(block)) return ports;
+  std::set<std::string> used_in, used_out;
+  for (const DocConnection& c : view.connections) {
+    if (c.to.block == block) used_in.insert(c.to.port);
+    if (c.from.block == block) used_out.insert(c.from.port);
+  }
+  for (const std::string& o : view.outputs) {
+    PortRef r;
+    if (PortRef::parse(o, r) && r.block == block) used_out.insert(r.port);
+  }
+  std::erase_if(ports.inputs, [&](const engine::PortDecl& p) { return !used_in.count(p.name); });
+  std::erase_if(ports.outputs, [&](const engine::PortDecl& p) { return !used_out.count(p.name); });
+  return ports;
+}
+
+void Canvas::draw(const View& view) {
+  const bool editable = level_.isEmpty();
   // Blocks: keep items whose shape is unchanged (selection and error marks survive), remake others.
   std::set<std::string> present;
-  for (const DocBlock& b : doc.blocks) {
+  for (const DocBlock& b : view.blocks) {
     present.insert(b.name);
-    const BlockPorts ports = controller_->ports(b.name);
+    const BlockPorts ports = shown_ports(view, b.name);
+    const BlockPorts& all = view.ports.at(b.name);
+    const size_t hidden = all.inputs.size() + all.outputs.size() - ports.inputs.size() - ports.outputs.size();
     BlockItem* item = block_item(b.name);
     bool reselect = false;
     if (item && !item->same_shape(b, ports)) {
@@ -58,16 +210,19 @@ void Canvas::sync() {
       blocks_.erase(b.name);
     }
     if (!item) {
-      const engine::BlockType* type = engine::Registry::global().find(b.type);
-      item = new BlockItem(b, type ? type->summary : "unknown block type", ports);
+      std::string summary = view.summaries.at(b.name);
+      if (hidden > 0)
+        summary += "\n" + std::to_string(hidden) + " ports not in use are hidden: View > Show all ports";
+      item = new BlockItem(b, summary, ports);
       const std::string name = b.name;
       item->on_moved = [this, name] { update_wires_of(name); };
       scene_.addItem(item);
       blocks_[b.name] = item;
       item->setSelected(reselect);
     }
+    item->setFlag(QGraphicsItem::ItemIsMovable, editable);
     if (item->pos() != QPointF(b.x, b.y)) item->setPos(b.x, b.y);
-    item->set_logged(doc.outputs);
+    item->set_logged(view.outputs);
   }
   for (auto it = blocks_.begin(); it != blocks_.end();) {
     if (present.count(it->first)) {
@@ -84,7 +239,7 @@ void Canvas::sync() {
     delete w;
   }
   wires_.clear();
-  for (const DocConnection& c : doc.connections) {
+  for (const DocConnection& c : view.connections) {
     BlockItem* from = block_item(c.from.block);
     BlockItem* to = block_item(c.to.block);
     PortItem* pf = from ? from->port(c.from.port, false) : nullptr;
@@ -94,6 +249,72 @@ void Canvas::sync() {
     scene_.addItem(w);
     wires_.push_back(w);
   }
+  grow_scene_rect();
+}
+
+void Canvas::grow_scene_rect() {
+  // The scene is the diagram plus a margin to drop and drag into: it grows and shrinks with it.
+  const QRectF items = scene_.itemsBoundingRect();
+  const QRectF shown = mapToScene(viewport()->rect()).boundingRect();
+  const double mx = std::max(400.0, shown.width() / 2), my = std::max(300.0, shown.height() / 2);
+  scene_.setSceneRect(items.isEmpty() ? QRectF(-mx, -my, 2 * mx, 2 * my) : items.adjusted(-mx, -my, mx, my));
+}
+
+bool Canvas::open_subsystem(const QString& block) {
+  const QStringList before = level_;
+  level_ << block;
+  View view;
+  if (!make_view(view)) {
+    level_ = before;
+    return false;
+  }
+  for (auto& [name, item] : blocks_) {
+    scene_.removeItem(item);
+    delete item;
+  }
+  blocks_.clear();
+  for (WireItem* w : wires_) {
+    scene_.removeItem(w);
+    delete w;
+  }
+  wires_.clear();
+  draw(view);
+  emit level_changed(level_);
+  emit message(tr("inside %1 (read only): Alt+Up or the breadcrumb goes back").arg(level_.join(" ▸ ")));
+  fit_all();
+  return true;
+}
+
+void Canvas::close_subsystem(int levels) {
+  if (level_.isEmpty()) return;
+  const QString left = level_.back();
+  for (int i = 0; i < levels && !level_.isEmpty(); ++i) level_.removeLast();
+  for (auto& [name, item] : blocks_) {
+    scene_.removeItem(item);
+    delete item;
+  }
+  blocks_.clear();
+  for (WireItem* w : wires_) {
+    scene_.removeItem(w);
+    delete w;
+  }
+  wires_.clear();
+  sync();
+  emit level_changed(level_);
+  emit message({});
+  fit_all();
+  if (levels == 1) select_block(left);
+}
+
+void Canvas::mouseDoubleClickEvent(QMouseEvent* e) {
+  for (QGraphicsItem* item : items(e->pos())) {
+    for (QGraphicsItem* at = item; at; at = at->parentItem())
+      if (auto* b = qgraphicsitem_cast<BlockItem*>(at)) {
+        if (!open_subsystem(q(b->name()))) QGraphicsView::mouseDoubleClickEvent(e);
+        return;
+      }
+  }
+  QGraphicsView::mouseDoubleClickEvent(e);
 }
 
 void Canvas::update_wires_of(const std::string& block) {
@@ -102,6 +323,10 @@ void Canvas::update_wires_of(const std::string& block) {
 }
 
 QString Canvas::drop_block(const QString& type, QPointF pos) {
+  if (!at_scene_level()) {
+    emit message(tr("refused: the inside of a subsystem is read only here; go back to the scene to add blocks"));
+    return {};
+  }
   const QString name = controller_->add_block(type, pos);
   if (name.isEmpty()) emit message(tr("unknown block type '%1'").arg(type));
   else select_block(name);
@@ -119,6 +344,7 @@ QString Canvas::wire(const PortRef& a, bool a_is_input, const PortRef& b, bool b
 }
 
 void Canvas::delete_selection() {
+  if (!at_scene_level()) return;
   QStringList blocks;
   std::vector<DocConnection> wires;
   for (QGraphicsItem* item : scene_.selectedItems()) {
@@ -196,8 +422,30 @@ void Canvas::dropEvent(QDropEvent* e) {
   e->acceptProposedAction();
 }
 
+bool Canvas::find_block(const QString& text) {
+  // The first block whose name contains the text (case-insensitive), the exact name first.
+  BlockItem* found = block_item(text.toStdString());
+  for (auto it = blocks_.begin(); !found && it != blocks_.end(); ++it)
+    if (QString::fromStdString(it->first).contains(text, Qt::CaseInsensitive)) found = it->second;
+  if (!found || text.isEmpty()) {
+    emit message(tr("no block named like '%1' here").arg(text));
+    return false;
+  }
+  scene_.clearSelection();
+  found->setSelected(true);
+  centerOn(found);
+  emit message(tr("found %1").arg(q(found->name())));
+  return true;
+}
+
 void Canvas::mousePressEvent(QMouseEvent* e) {
-  if (e->button() == Qt::LeftButton) {
+  if (e->button() == Qt::MiddleButton) {
+    // Pan: the diagram follows the mouse while the middle button is held.
+    pan_from_ = e->pos();
+    panning_ = true;
+    return;
+  }
+  if (e->button() == Qt::LeftButton && at_scene_level()) {
     if (PortItem* p = port_at(e->pos())) {
       drag_from_ = p;
       drag_wire_ = scene_.addPath(wire_path(p->anchor(), p->anchor()), QPen(QColor(30, 100, 220), 1.8, Qt::DashLine));
@@ -208,6 +456,13 @@ void Canvas::mousePressEvent(QMouseEvent* e) {
 }
 
 void Canvas::mouseMoveEvent(QMouseEvent* e) {
+  if (panning_) {
+    const QPoint d = e->pos() - pan_from_;
+    pan_from_ = e->pos();
+    horizontalScrollBar()->setValue(horizontalScrollBar()->value() - d.x());
+    verticalScrollBar()->setValue(verticalScrollBar()->value() - d.y());
+    return;
+  }
   if (!drag_from_) return QGraphicsView::mouseMoveEvent(e);
   const QPointF at = mapToScene(e->pos());
   const QPointF a = drag_from_->anchor();
@@ -229,6 +484,10 @@ void Canvas::mouseMoveEvent(QMouseEvent* e) {
 }
 
 void Canvas::mouseReleaseEvent(QMouseEvent* e) {
+  if (panning_ && e->button() == Qt::MiddleButton) {
+    panning_ = false;
+    return;
+  }
   if (!drag_from_) {
     QGraphicsView::mouseReleaseEvent(e);
     commit_moves();
@@ -245,6 +504,7 @@ void Canvas::mouseReleaseEvent(QMouseEvent* e) {
 }
 
 void Canvas::commit_moves() {
+  if (!at_scene_level()) return;
   // Blocks dragged with the mouse: one undo step for all that moved.
   std::vector<std::pair<QString, QPointF>> moved;
   for (const DocBlock& b : controller_->document().blocks)

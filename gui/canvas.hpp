@@ -5,6 +5,7 @@
 
 #include <QGraphicsView>
 #include <map>
+#include <set>
 
 #include "gui/diagram_items.hpp"
 #include "gui/scene_controller.hpp"
@@ -38,11 +39,30 @@ class Canvas : public QGraphicsView {
   void clear_errors();
   /// Notes under objective blocks (their value after a run).
   void set_notes(const std::map<std::string, QString>& notes);
+  /// Fits the whole diagram in the view (never magnifying beyond natural size).
   void fit_all();
+  /// Selects and centres the block named `text` (or the first whose name contains it) at the
+  /// level shown; false when there is none.
+  bool find_block(const QString& text);
+
+  /// Shows the inside of subsystem instance `block` of the level shown (a double-click on it);
+  /// false when it is not an instance whose definition is known.
+  bool open_subsystem(const QString& block);
+  /// Back to the enclosing level (`levels` up; the breadcrumb's entries).
+  void close_subsystem(int levels = 1);
+  /// The instances opened, outermost first; empty at the scene's level.
+  const QStringList& level() const { return level_; }
+  /// A block with more than kPortsShownAll ports shows only those wired or logged, unless
+  /// toggled to show all (View > Show all ports).
+  static constexpr size_t kPortsShownAll = 30;
+  void toggle_all_ports(const QString& block);
+  /// Whether the level shown is the scene's own (editable) one.
+  bool at_scene_level() const { return level_.isEmpty(); }
 
  signals:
   void message(const QString& text);
   void selection_changed(const QString& block);
+  void level_changed(const QStringList& level);
 
  public slots:
   void sync();
@@ -56,8 +76,22 @@ class Canvas : public QGraphicsView {
   void mouseReleaseEvent(QMouseEvent* e) override;
   void keyPressEvent(QKeyEvent* e) override;
   void wheelEvent(QWheelEvent* e) override;
+  void mouseDoubleClickEvent(QMouseEvent* e) override;
 
  private:
+  /// What is drawn at the current level: blocks, connections and each block's ports.
+  struct View {
+    std::vector<DocBlock> blocks;
+    std::vector<DocConnection> connections;
+    std::map<std::string, BlockPorts> ports;
+    std::map<std::string, std::string> summaries;
+    std::vector<std::string> outputs;  ///< logged (the scene's level only)
+  };
+  /// The view of level_, or false when a level no longer exists (then back to the scene).
+  bool make_view(View& view) const;
+  void draw(const View& view);
+  BlockPorts shown_ports(const View& view, const std::string& block) const;
+  void grow_scene_rect();
   PortItem* port_at(QPoint view_pos) const;
   void update_wires_of(const std::string& block);
   void commit_moves();
@@ -70,6 +104,11 @@ class Canvas : public QGraphicsView {
   PortItem* drag_from_ = nullptr;
   PortItem* drag_over_ = nullptr;
   QGraphicsPathItem* drag_wire_ = nullptr;
+  QStringList level_;
+  QString shown_file_;
+  bool panning_ = false;
+  QPoint pan_from_;
+  std::set<std::string> all_ports_;  ///< blocks showing every port
 };
 
 }  // namespace dydp::gui

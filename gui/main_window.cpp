@@ -5,6 +5,7 @@
 #include <QDockWidget>
 #include <QFileDialog>
 #include <QFileInfo>
+#include <QLineEdit>
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QStatusBar>
@@ -75,6 +76,16 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   edit->addAction(redo);
   auto* act_delete = edit->addAction(tr("&Delete"), this, [this] { canvas_->delete_selection(); });
   edit->addAction(tr("&Fit diagram"), this, [this] { canvas_->fit_all(); });
+  auto* view = menuBar()->addMenu(tr("&View"));
+  view->addAction(tr("&Open subsystem"), QKeySequence(Qt::ALT | Qt::Key_Down), this, [this] {
+    const QStringList sel = canvas_->selected_blocks();
+    if (sel.size() != 1 || !canvas_->open_subsystem(sel.front()))
+      status(tr("select one subsystem block (or double-click it) to open it"));
+  });
+  view->addAction(tr("Show &all ports of the selected block"), this, [this] {
+    for (const QString& b : canvas_->selected_blocks()) canvas_->toggle_all_ports(b);
+  });
+  view->addAction(tr("&Up from subsystem"), QKeySequence(Qt::ALT | Qt::Key_Up), this, [this] { canvas_->close_subsystem(); });
   run_action_ = run_menu->addAction(tr("&Run"), QKeySequence(Qt::Key_F5), this, [this] { start_run(); });
   cancel_action_ = run_menu->addAction(tr("&Cancel"), QKeySequence(Qt::Key_Escape), this, [this] { worker_.cancel(); });
   cancel_action_->setEnabled(false);
@@ -93,6 +104,31 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   progress_->setFormat("%p%");
   tools->addWidget(progress_);
 
+  // Where the canvas is: the scene, or the subsystem instances opened; each entry goes back there.
+  auto* where = addToolBar(tr("Level"));
+  where->setObjectName("level_toolbar");
+  find_ = new QLineEdit;
+  find_->setObjectName("find_block");
+  find_->setPlaceholderText(tr("find block (Ctrl+F)"));
+  find_->setMaximumWidth(220);
+  where->addWidget(find_);
+  connect(find_, &QLineEdit::returnPressed, this, [this] { canvas_->find_block(find_->text().trimmed()); });
+  auto* find_action = new QAction(this);
+  find_action->setShortcut(QKeySequence::Find);
+  connect(find_action, &QAction::triggered, this, [this] {
+    find_->setFocus();
+    find_->selectAll();
+  });
+  addAction(find_action);
+  breadcrumb_ = new QLabel;
+  breadcrumb_->setTextFormat(Qt::RichText);
+  where->addWidget(breadcrumb_);
+  connect(breadcrumb_, &QLabel::linkActivated, this, [this](const QString& link) {
+    canvas_->close_subsystem(static_cast<int>(canvas_->level().size()) - link.toInt());
+  });
+  connect(canvas_, &Canvas::level_changed, this, &MainWindow::update_breadcrumb);
+  update_breadcrumb(canvas_->level());
+
   status_label_ = new QLabel;
   statusBar()->addWidget(status_label_, 1);
 
@@ -109,7 +145,12 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   });
   connect(&controller_, &SceneController::file_changed, this, &MainWindow::update_title);
   connect(controller_.undo_stack(), &QUndoStack::cleanChanged, this, &MainWindow::update_title);
-  connect(&controller_, &SceneController::document_changed, this, [this] { canvas_->clear_errors(); });
+  // An edit makes the last message stale (a refusal, an invalid scene): clear it; a message the
+  // edit itself sends comes after this.
+  connect(&controller_, &SceneController::document_changed, this, [this] {
+    canvas_->clear_errors();
+    status({});
+  });
   connect(&worker_, &RunWorker::progress, this, [this](double f) { progress_->setValue(static_cast<int>(f * 1000)); });
   connect(&worker_, &RunWorker::finished, this, &MainWindow::run_finished);
   resize(1500, 950);
@@ -117,6 +158,15 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
 }
 
 void MainWindow::status(const QString& text) { status_label_->setText(text); }
+
+void MainWindow::update_breadcrumb(const QStringList& level) {
+  QString text = level.isEmpty() ? tr("<b>scene</b>") : QString("<a href=\"0\">%1</a>").arg(tr("scene"));
+  for (qsizetype i = 0; i < level.size(); ++i)
+    text += " \u25b8 " + (i + 1 == level.size() ? "<b>" + level[i].toHtmlEscaped() + "</b>"
+                                                : QString("<a href=\"%1\">%2</a>").arg(i + 1).arg(level[i].toHtmlEscaped()));
+  if (!level.isEmpty()) text += tr("  <i>(read only; Alt+Up: back)</i>");
+  breadcrumb_->setText(text);
+}
 
 void MainWindow::update_title() {
   const QString path = controller_.file_path();
@@ -133,7 +183,7 @@ bool MainWindow::open_file(const QString& path, bool quiet) {
     status(last_error_);
     return false;
   }
-  results_->clear();
+  results_->forget_runs();
   canvas_->fit_all();
   status(tr("opened %1").arg(path));
   return true;
@@ -179,7 +229,12 @@ bool MainWindow::start_run() {
     const QStringList blocks = controller_.blocks_of_error(e);
     canvas_->show_error(blocks, last_error_);
     if (blocks.size() == 1) canvas_->select_block(blocks.front());
-    status(tr("invalid scene: %1").arg(last_error_));
+    if (e.field() == "outputs" && controller_.document().outputs.empty())
+      // A new diagram: say where outputs are chosen rather than what the file lacks.
+      status(tr("Nothing to compute yet: select a block and tick the signals to log under \"Logged outputs\" "
+                "in the Block tab, or drop an objective block (objectives are computed by default)."));
+    else
+      status(tr("invalid scene: %1").arg(last_error_));
     return false;
   }
   last_error_.clear();
@@ -197,7 +252,7 @@ void MainWindow::run_finished(const RunOutcome& outcome) {
   switch (outcome.status) {
     case RunOutcome::Status::finished: {
       progress_->setValue(1000);
-      results_->show_result(outcome.result);
+      results_->show_result(outcome.result, outcome.diagram);
       std::map<std::string, QString> notes;
       for (const auto& o : outcome.result->objectives) notes[o.name] = QString("ψ = %1").arg(o.value, 0, 'g', 6);
       canvas_->set_notes(notes);

@@ -4,6 +4,7 @@
 
 #include <QAction>
 #include <QLabel>
+#include <QLineEdit>
 #include <QMainWindow>
 #include <QProgressBar>
 
@@ -29,6 +30,10 @@ class MainWindow : public QMainWindow {
   PropertyEditor* property_editor() { return properties_; }
   ScenePanel* scene_panel() { return scene_panel_; }
   ResultsPanel* results() { return results_; }
+  QLabel* breadcrumb() { return breadcrumb_; }
+  QLineEdit* find_field() { return find_; }
+  /// The message shown in the status bar.
+  QString status_text() const { return status_label_->text(); }
   RunWorker* worker() { return &worker_; }
   QProgressBar* progress_bar() { return progress_; }
 
@@ -51,6 +56,7 @@ class MainWindow : public QMainWindow {
   void update_title();
   void run_finished(const RunOutcome& outcome);
   void status(const QString& text);
+  void update_breadcrumb(const QStringList& level);
 
   SceneController controller_;
   RunWorker worker_;
@@ -63,6 +69,8 @@ class MainWindow : public QMainWindow {
   QAction* run_action_;
   QAction* cancel_action_;
   QLabel* status_label_;
+  QLabel* breadcrumb_;
+  QLineEdit* find_;
   QString last_error_;
 };
 

@@ -92,6 +92,13 @@ QStringList Palette::sections() const {
   return out;
 }
 
+QTreeWidgetItem* Palette::entry(const QString& type) const {
+  for (int i = 0; i < topLevelItemCount(); ++i)
+    for (int j = 0; j < topLevelItem(i)->childCount(); ++j)
+      if (topLevelItem(i)->child(j)->data(0, kTypeRole).toString() == type) return topLevelItem(i)->child(j);
+  return nullptr;
+}
+
 QStringList Palette::mimeTypes() const { return {kBlockTypeMime}; }
 
 QMimeData* Palette::mimeData(const QList<QTreeWidgetItem*>& items) const {

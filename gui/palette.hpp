@@ -13,6 +13,10 @@ class Palette : public QTreeWidget {
   explicit Palette(QWidget* parent = nullptr);
   /// The section titles shown, in order.
   QStringList sections() const;
+  /// The entry of a block type, or null.
+  QTreeWidgetItem* entry(const QString& type) const;
+  /// What a drag of `entry` carries to the canvas (the block type under kBlockTypeMime).
+  QMimeData* drag_data(QTreeWidgetItem* entry) const { return mimeData({entry}); }
 
  signals:
   /// A double-clicked entry: add the type at a free place.

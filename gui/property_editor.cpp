@@ -1,5 +1,8 @@
 #include "gui/property_editor.hpp"
 
+#include <QMenu>
+#include <QPushButton>
+
 #include <QFormLayout>
 #include <QHeaderView>
 #include <QVBoxLayout>
@@ -45,6 +48,29 @@ PropertyEditor::PropertyEditor(SceneController* controller, QWidget* parent)
   table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   table_->horizontalHeader()->setStretchLastSection(true);
   layout->addWidget(table_, 3);
+  // A block parameter as a sensitivity direction in one step (also on the row's context menu).
+  make_direction_ = new QPushButton(tr("Make direction d/dp of the selected parameter"));
+  make_direction_->setObjectName("make_direction");
+  make_direction_->setToolTip(tr("drive the parameter by a scene parameter (new, or the one already in $name) and "
+                                 "add it to the sensitivity directions"));
+  layout->addWidget(make_direction_);
+  connect(make_direction_, &QPushButton::clicked, this, [this] {
+    const int row = table_->currentRow();
+    if (row < 0 || !table_->item(row, kName)) {
+      status_->setText(tr("select a parameter row first"));
+      return;
+    }
+    make_direction(table_->item(row, kName)->text());
+  });
+  table_->setContextMenuPolicy(Qt::CustomContextMenu);
+  connect(table_, &QWidget::customContextMenuRequested, this, [this](const QPoint& at) {
+    const QTableWidgetItem* item = table_->itemAt(at);
+    if (!item || !table_->item(item->row(), kName)) return;
+    const QString key = table_->item(item->row(), kName)->text();
+    QMenu menu;
+    menu.addAction(tr("Make %1 a direction d/dp").arg(key), this, [this, key] { make_direction(key); });
+    menu.exec(table_->viewport()->mapToGlobal(at));
+  });
   layout->addWidget(new QLabel(tr("Logged outputs")));
   outputs_ = new QListWidget;
   layout->addWidget(outputs_, 1);
@@ -76,6 +102,16 @@ PropertyEditor::PropertyEditor(SceneController* controller, QWidget* parent)
     controller_->set_output(item->data(Qt::UserRole).toString(), item->checkState() == Qt::Checked);
   });
   refresh();
+}
+
+QString PropertyEditor::make_direction(const QString& key) {
+  QString parameter;
+  const QString why = controller_->make_direction(block_, key, &parameter);
+  status_->setText(why);
+  if (why.isEmpty()) emit message(tr("%1.%2 is driven by $%3, a sensitivity direction: run to get dψ/d%3")
+                                      .arg(block_, key, parameter));
+  else emit message(tr("refused: %1").arg(why));
+  return why;
 }
 
 void PropertyEditor::set_block(const QString& name) {
@@ -111,7 +147,10 @@ void PropertyEditor::refresh() {
   }
   name_->setText(block_);
   type_->setText(q(b->type));
-  summary_->setText(type ? q(type->summary) : tr("unknown block type"));
+  const DocSubsystem* def = doc.subsystem_of(*b);
+  summary_->setText(type ? q(type->summary)
+                         : def ? tr("subsystem %1: %2 (double-click the block to open it)").arg(q(def->name), q(def->description))
+                               : tr("unknown block type"));
   auto add_row = [&](const QString& key, const QString& value, const QString& unit, const QString& def,
                      const QString& range, const QString& tip, bool setting) {
     const int row = table_->rowCount();
@@ -144,6 +183,12 @@ void PropertyEditor::refresh() {
               s.required ? tr("required") : q(s.default_value), {}, q(s.description), true);
     }
   }
+  if (def)
+    for (const auto& [name, default_value] : def->parameters) {
+      const SceneValue* v = b->find(name);
+      add_row(q(name), v ? q(v->text()) : QString(), {}, default_value.items.empty() ? tr("required") : q(default_value.text()),
+              {}, tr("parameter of subsystem %1").arg(q(def->name)), false);
+    }
   const BlockPorts ports = controller_->ports(b->name);
   auto add_output = [&](const QString& label, const QString& ref) {
     auto* item = new QListWidgetItem(label, outputs_);

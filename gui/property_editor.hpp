@@ -6,6 +6,7 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QListWidget>
+#include <QPushButton>
 #include <QTableWidget>
 #include <QWidget>
 
@@ -23,6 +24,9 @@ class PropertyEditor : public QWidget {
   /// Applies text to the parameter or setting in `row` as if typed; returns the refusal or "".
   QString edit_value(const QString& key, const QString& text);
   QTableWidget* table() { return table_; }
+  /// Makes parameter `key` of the block a sensitivity direction (SceneController::make_direction).
+  QString make_direction(const QString& key);
+  QPushButton* make_direction_button() { return make_direction_; }
 
  public slots:
   void refresh();
@@ -39,6 +43,7 @@ class PropertyEditor : public QWidget {
   QTableWidget* table_;
   QListWidget* outputs_;
   QLabel* status_;
+  QPushButton* make_direction_;
   bool refreshing_ = false;
 };
 

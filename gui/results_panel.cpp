@@ -26,9 +26,16 @@ QChartView* make_chart_view() {
   return view;
 }
 
-/// Replaces the chart's series by the given curves against t, with fitted axes.
-void set_curves(QChartView* view, const QString& title, const std::vector<double>& t,
-                const std::vector<std::pair<QString, std::vector<double>>>& curves) {
+/// One curve of a chart: values against its own time grid; dashed for the previous run.
+struct Curve {
+  QString name;
+  const std::vector<double>* t;
+  std::vector<double> v;
+  bool dashed = false;
+};
+
+/// Replaces the chart's series by the given curves, with fitted axes.
+void set_curves(QChartView* view, const QString& title, const QString& y_title, const std::vector<Curve>& curves) {
   QChart* chart = view->chart();
   chart->removeAllSeries();
   for (QAbstractAxis* a : chart->axes()) {
@@ -36,29 +43,38 @@ void set_curves(QChartView* view, const QString& title, const std::vector<double
     delete a;
   }
   chart->setTitle(title);
-  if (t.empty() || curves.empty()) return;
-  double lo = INFINITY, hi = -INFINITY;
+  if (curves.empty() || curves.front().t->empty()) return;
+  double lo = INFINITY, hi = -INFINITY, t0 = INFINITY, t1 = -INFINITY;
   auto* x = new QValueAxis;
   auto* y = new QValueAxis;
   x->setTitleText("t [s]");
-  x->setRange(t.front(), t.back());
+  y->setTitleText(y_title);
   chart->addAxis(x, Qt::AlignBottom);
   chart->addAxis(y, Qt::AlignLeft);
-  for (const auto& [name, v] : curves) {
+  for (const Curve& c : curves) {
     auto* s = new QLineSeries;
-    s->setName(name);
+    s->setName(c.name);
     QList<QPointF> points;
-    points.reserve(static_cast<qsizetype>(t.size()));
-    for (size_t k = 0; k < t.size(); ++k) {
-      points.append({t[k], v[k]});
-      lo = std::min(lo, v[k]);
-      hi = std::max(hi, v[k]);
+    points.reserve(static_cast<qsizetype>(c.t->size()));
+    for (size_t k = 0; k < c.t->size() && k < c.v.size(); ++k) {
+      points.append({(*c.t)[k], c.v[k]});
+      lo = std::min(lo, c.v[k]);
+      hi = std::max(hi, c.v[k]);
     }
+    t0 = std::min(t0, c.t->front());
+    t1 = std::max(t1, c.t->back());
     s->replace(points);
     chart->addSeries(s);
     s->attachAxis(x);
     s->attachAxis(y);
+    if (c.dashed) {
+      QPen pen = s->pen();
+      pen.setStyle(Qt::DashLine);
+      pen.setColor(QColor(150, 150, 150));
+      s->setPen(pen);
+    }
   }
+  x->setRange(t0, t1);
   if (!(hi > lo)) {
     lo -= 1;
     hi += 1;
@@ -75,7 +91,7 @@ ResultsPanel::ResultsPanel(QWidget* parent) : QWidget(parent) {
   auto* left_layout = new QVBoxLayout(left);
   left_layout->setContentsMargins(0, 0, 0, 0);
   left_layout->addWidget(new QLabel(tr("Objectives")));
-  objectives_ = new QTableWidget(0, 2);
+  objectives_ = new QTableWidget(0, 4);
   objectives_->verticalHeader()->hide();
   objectives_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   objectives_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
@@ -92,6 +108,8 @@ ResultsPanel::ResultsPanel(QWidget* parent) : QWidget(parent) {
   split->addWidget(left);
   split->addWidget(charts);
   split->setStretchFactor(1, 3);
+  // Wide enough for an objective, a dψ/dp label and a value to the last digit with its unit.
+  left->setMinimumWidth(520);
   layout->addWidget(split);
   connect(signal_, &QComboBox::currentIndexChanged, this, &ResultsPanel::plot_signal);
   clear();
@@ -99,35 +117,69 @@ ResultsPanel::ResultsPanel(QWidget* parent) : QWidget(parent) {
 
 void ResultsPanel::clear() {
   result_.reset();
+  diagram_.reset();
   objectives_->setRowCount(0);
-  objectives_->setColumnCount(2);
-  objectives_->setHorizontalHeaderLabels({tr("objective"), tr("ψ")});
+  objectives_->setColumnCount(4);
+  objectives_->setHorizontalHeaderLabels({tr("objective"), tr("quantity"), tr("value"), tr("unit")});
   signal_->clear();
   set_curves(value_chart_, tr("signal"), {}, {});
   set_curves(sens_chart_, tr("sensitivities"), {}, {});
 }
 
-void ResultsPanel::show_result(std::shared_ptr<const engine::RunResult> result) {
+void ResultsPanel::forget_runs() {
+  clear();
+  previous_.reset();
+}
+
+QString ResultsPanel::parameter_unit(size_t d) const {
+  if (!diagram_ || d >= diagram_->sensitivities.size()) return {};
+  return q(diagram_->parameters[diagram_->sensitivities[d]].unit);
+}
+
+QString ResultsPanel::signal_unit(int i) const {
+  if (!diagram_ || i < 0 || i >= static_cast<int>(diagram_->logged.size())) return {};
+  return q(diagram_->signal_unit(diagram_->logged[i].offset));
+}
+
+QString ResultsPanel::full_number(double v) { return QString::number(v, 'g', QLocale::FloatingPointShortest); }
+
+void ResultsPanel::show_result(std::shared_ptr<const engine::RunResult> result,
+                               std::shared_ptr<const engine::Diagram> diagram) {
+  // The run shown so far stays, dashed, for comparison with the new one.
+  if (result_) previous_ = result_;
   clear();
   result_ = std::move(result);
+  diagram_ = std::move(diagram);
   const auto& r = *result_;
-  QStringList headers = {tr("objective"), tr("ψ")};
-  for (const auto& p : r.sensitivity_names) headers << QString("dψ/d%1").arg(q(p));
-  objectives_->setColumnCount(headers.size());
-  objectives_->setHorizontalHeaderLabels(headers);
-  for (const auto& o : r.objectives) {
+  // One row per figure: psi, then d(psi)/dp for every direction, each with its full value and
+  // unit, so that no direction is cut off however many there are.
+  const auto add = [this](const QString& objective, const QString& quantity, double value, const QString& unit) {
     const int row = objectives_->rowCount();
     objectives_->insertRow(row);
-    objectives_->setItem(row, 0, new QTableWidgetItem(q(o.name)));
-    objectives_->setItem(row, 1, new QTableWidgetItem(QString::number(o.value, 'g', 8)));
-    for (size_t d = 0; d < o.sensitivity.size(); ++d)
-      objectives_->setItem(row, 2 + static_cast<int>(d), new QTableWidgetItem(QString::number(o.sensitivity[d], 'g', 8)));
+    objectives_->setItem(row, 0, new QTableWidgetItem(objective));
+    objectives_->setItem(row, 1, new QTableWidgetItem(quantity));
+    auto* v = new QTableWidgetItem(full_number(value));
+    v->setTextAlignment(Qt::AlignRight | Qt::AlignVCenter);
+    objectives_->setItem(row, 2, v);
+    objectives_->setItem(row, 3, new QTableWidgetItem(unit));
+  };
+  for (const auto& o : r.objectives) {
+    add(q(o.name), QString("ψ"), o.value, q(o.unit));
+    for (size_t d = 0; d < o.sensitivity.size() && d < r.sensitivity_names.size(); ++d)
+      add(q(o.name), QString("dψ/d%1").arg(q(r.sensitivity_names[d])), o.sensitivity[d],
+          q(engine::unit_per(o.unit, parameter_unit(d).toStdString())));
   }
   {
     const QSignalBlocker block(signal_);
     for (const auto& name : r.signal_names) signal_->addItem(q(name));
   }
   if (!r.signal_names.empty()) plot_signal(0);
+}
+
+int ResultsPanel::find_row(const QString& objective, const QString& quantity) const {
+  for (int row = 0; row < objectives_->rowCount(); ++row)
+    if (objectives_->item(row, 0)->text() == objective && objectives_->item(row, 1)->text() == quantity) return row;
+  return -1;
 }
 
 void ResultsPanel::plot_signal(int i) {
@@ -137,16 +189,34 @@ void ResultsPanel::plot_signal(int i) {
   std::vector<double> v(n);
   for (size_t k = 0; k < n; ++k) v[k] = r.value(static_cast<int>(k), i);
   const QString name = q(r.signal_names[i]);
-  set_curves(value_chart_, name, r.t, {{name, v}});
-  std::vector<std::pair<QString, std::vector<double>>> sens;
+  const QString unit = signal_unit(i);
+  std::vector<Curve> values = {{name, &r.t, std::move(v)}};
+  // The same signal of the previous run, when it has one.
+  const int j = previous_ ? previous_->signal_index(r.signal_names[i]) : -1;
+  if (j >= 0) {
+    std::vector<double> pv(previous_->t.size());
+    for (size_t k = 0; k < pv.size(); ++k) pv[k] = previous_->value(static_cast<int>(k), j);
+    values.push_back({name + tr(" (previous run)"), &previous_->t, std::move(pv), true});
+  }
+  set_curves(value_chart_, name, unit.isEmpty() ? name : QString("%1 [%2]").arg(name, unit), values);
+  std::vector<Curve> sens;
   if (!r.tangents.empty()) {
     for (size_t d = 0; d < r.sensitivity_names.size(); ++d) {
       std::vector<double> dv(n);
       for (size_t k = 0; k < n; ++k) dv[k] = r.tangent(static_cast<int>(k), static_cast<int>(d), i);
-      sens.emplace_back(QString("d/d%1").arg(q(r.sensitivity_names[d])), std::move(dv));
+      const QString per = q(engine::unit_per(unit.toStdString(), parameter_unit(d).toStdString()));
+      sens.push_back({QString("d/d%1").arg(q(r.sensitivity_names[d])) + (per.isEmpty() ? "" : " [" + per + "]"),
+                      &r.t, std::move(dv)});
     }
   }
-  set_curves(sens_chart_, tr("sensitivities of %1").arg(name), r.t, sens);
+  // The axis names the unit when all directions share it; else each curve's name carries its own.
+  QString per_all;
+  for (size_t d = 0; d < r.sensitivity_names.size(); ++d) {
+    const QString per = q(engine::unit_per(unit.toStdString(), parameter_unit(d).toStdString()));
+    per_all = d == 0 || per == per_all ? per : QString("mixed");
+  }
+  set_curves(sens_chart_, tr("sensitivities of %1").arg(name),
+             QString("d(%1)/dp").arg(name) + (per_all.isEmpty() || per_all == "mixed" ? "" : " [" + per_all + "]"), sens);
   if (signal_->currentIndex() != i) {
     const QSignalBlocker block(signal_);
     signal_->setCurrentIndex(i);

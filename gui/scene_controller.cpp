@@ -1,5 +1,7 @@
 #include "gui/scene_controller.hpp"
 
+#include "gui/subsystem_ports.hpp"
+
 #include <QDir>
 #include <QFileInfo>
 #include <QRegularExpression>
@@ -63,6 +65,7 @@ void SceneController::new_scene() {
 void SceneController::open(const QString& path) {
   SceneDocument doc = read_scene_file(s(path));
   place_unplaced_blocks(doc);
+  for (DocSubsystem& def : doc.subsystems) place_unplaced_blocks(def.blocks, def.connections);
   undo_.clear();
   path_ = path;
   replace(doc);
@@ -93,6 +96,7 @@ const engine::BlockType* SceneController::type_of(const std::string& block) cons
 
 BlockPorts SceneController::ports(const std::string& block) const {
   const DocBlock* b = doc_.find_block(block);
+  if (b && doc_.subsystem_of(*b)) return instance_ports(doc_, *b);
   const engine::BlockType* type = b ? engine::Registry::global().find(b->type) : nullptr;
   if (!type) {
     BlockPorts none;
@@ -108,16 +112,21 @@ BlockPorts SceneController::ports(const std::string& block) const {
 }
 
 void SceneController::place_unplaced_blocks(SceneDocument& doc) const {
+  place_unplaced_blocks(doc.blocks, doc.connections);
+}
+
+void SceneController::place_unplaced_blocks(std::vector<DocBlock>& blocks,
+                                            const std::vector<DocConnection>& connections) const {
   // Columns by signal flow: a block sits one column right of the furthest block driving it
   // (longest path from the sources; cycles stop growing after as many rounds as blocks).
   std::map<std::string, int> column;
-  for (const auto& b : doc.blocks) column[b.name] = 0;
-  for (size_t round = 0; round < doc.blocks.size(); ++round) {
+  for (const auto& b : blocks) column[b.name] = 0;
+  for (size_t round = 0; round < blocks.size(); ++round) {
     bool changed = false;
-    for (const auto& c : doc.connections) {
+    for (const auto& c : connections) {
       if (!column.count(c.from.block) || !column.count(c.to.block) || c.from.block == c.to.block) continue;
       const int want = column[c.from.block] + 1;
-      if (column[c.to.block] < want && want < static_cast<int>(doc.blocks.size())) {
+      if (column[c.to.block] < want && want < static_cast<int>(blocks.size())) {
         column[c.to.block] = want;
         changed = true;
       }
@@ -125,7 +134,7 @@ void SceneController::place_unplaced_blocks(SceneDocument& doc) const {
     if (!changed) break;
   }
   std::map<int, int> rows;
-  for (auto& b : doc.blocks) {
+  for (auto& b : blocks) {
     const int col = column[b.name];
     const int row = rows[col]++;
     if (b.placed) continue;
@@ -149,6 +158,8 @@ QString SceneController::add_block(const QString& type_name, QPointF pos) {
   for (const auto& p : type->parameters)
     if (p.required) b.set(p.name, SceneValue::scalar(number_text(p.default_value)));
   after.blocks.push_back(b);
+  // A new objective is computed by default: that is what it was dropped for.
+  if (ports_of(*type, b).is_objective) after.outputs.push_back(b.name);
   commit(tr("Add %1").arg(q(b.name)), std::move(after));
   return q(b.name);
 }
@@ -258,9 +269,20 @@ QString SceneController::set_block_value(const QString& block_name, const QStrin
   SceneDocument after = doc_;
   DocBlock* b = after.find_block(s(block_name));
   if (!b) return tr("no block '%1'").arg(block_name);
+  const QString field = block_name + "." + key_q;
+  if (const DocSubsystem* def = doc_.subsystem_of(*b)) {
+    // An instance's parameter: a value for the subsystem (checked by the engine where it is used).
+    const bool known = std::any_of(def->parameters.begin(), def->parameters.end(),
+                                   [&](const auto& p) { return p.first == key; });
+    if (!known) return tr("%1: unknown parameter of subsystem %2").arg(field, q(def->name));
+    if (!text.empty() && text[0] == '$' && !doc_.find_parameter(text.substr(1)))
+      return tr("%1: unknown scene parameter '%2'").arg(field, q(text));
+    b->set(key, text.empty() ? SceneValue::scalar("") : SceneValue::parse(text));
+    commit(tr("Set %1").arg(field), std::move(after));
+    return {};
+  }
   const engine::BlockType* type = engine::Registry::global().find(b->type);
   if (!type) return tr("unknown block type '%1'").arg(q(b->type));
-  const QString field = block_name + "." + key_q;
 
   if (const int j = parameter_index(*type, key); j >= 0) {
     const engine::ParamSpec& spec = type->parameters[j];
@@ -415,6 +437,43 @@ QString SceneController::remove_scene_parameter(const QString& name_q) {
   std::erase_if(after.parameters, [&](const DocParameter& p) { return p.name == s(name_q); });
   std::erase(after.sensitivities, s(name_q));
   commit(tr("Delete parameter %1").arg(name_q), std::move(after));
+  return {};
+}
+
+QString SceneController::make_direction(const QString& block_q, const QString& key_q, QString* parameter) {
+  const std::string block = s(block_q), key = s(key_q);
+  const DocBlock* b = doc_.find_block(block);
+  if (!b) return tr("no block '%1'").arg(block_q);
+  const engine::BlockType* type = engine::Registry::global().find(b->type);
+  const int j = type ? parameter_index(*type, key) : -1;
+  if (j < 0) return tr("%1.%2: not a numeric parameter of %3").arg(block_q, key_q, q(b->type));
+  const engine::ParamSpec& spec = type->parameters[j];
+  if (!spec.differentiable)
+    return tr("%1.%2: not differentiable, cannot be a sensitivity direction").arg(block_q, key_q);
+  SceneDocument after = doc_;
+  DocBlock* target = after.find_block(block);
+  const SceneValue* v = target->find(key);
+  std::string name;
+  if (v && !v->is_list && !v->items.empty() && v->items.front().size() > 1 && v->items.front()[0] == '$') {
+    // Already driven by a scene parameter: that one becomes the direction.
+    name = v->items.front().substr(1);
+    if (!after.find_parameter(name)) return tr("%1.%2: unknown scene parameter '$%3'").arg(block_q, key_q, q(name));
+  } else {
+    // A new scene parameter named after the block and parameter, starting at the value in use.
+    name = after.unique_parameter_name(block + "_" + key);
+    DocParameter p;
+    p.name = name;
+    p.value = v && !v->items.empty() && !v->items.front().empty() ? v->items.front() : number_text(spec.default_value);
+    p.unit = spec.unit;
+    double value = 0;
+    if (!engine::parse_number(p.value, value)) return tr("%1.%2: malformed number '%3'").arg(block_q, key_q, q(p.value));
+    after.parameters.push_back(p);
+    target->set(key, SceneValue::scalar("$" + name));
+  }
+  if (std::find(after.sensitivities.begin(), after.sensitivities.end(), name) == after.sensitivities.end())
+    after.sensitivities.push_back(name);
+  if (parameter) *parameter = q(name);
+  commit(tr("Make %1.%2 a direction").arg(block_q, key_q), std::move(after));
   return {};
 }
 

@@ -60,6 +60,10 @@ class SceneController : public QObject {
   QString update_scene_parameter(const QString& name, const DocParameter& p);
   QString remove_scene_parameter(const QString& name);
   void set_sensitivity(const QString& name, bool on);
+  /// Makes a block parameter a sensitivity direction in one step: the scene parameter driving it
+  /// (`$name`), or a new one named BLOCK_PARAMETER holding its current value and unit, becomes a
+  /// direction. `parameter` receives the scene parameter's name.
+  QString make_direction(const QString& block, const QString& key, QString* parameter = nullptr);
 
   /// The ports of a block of the document (cached per type and settings).
   BlockPorts ports(const std::string& block) const;
@@ -81,6 +85,7 @@ class SceneController : public QObject {
   void commit(const QString& label, SceneDocument after);
   void replace(const SceneDocument& doc);
   void place_unplaced_blocks(SceneDocument& doc) const;
+  void place_unplaced_blocks(std::vector<DocBlock>& blocks, const std::vector<DocConnection>& connections) const;
   /// Drops connections and outputs that the block's current ports no longer support.
   void drop_dangling(SceneDocument& doc, const std::string& block) const;
 

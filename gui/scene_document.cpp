@@ -81,6 +81,24 @@ bool PortRef::parse(const std::string& text, PortRef& out) {
   return true;
 }
 
+const DocBlock* DocSubsystem::find_block(const std::string& name) const {
+  for (const DocBlock& b : blocks)
+    if (b.name == name) return &b;
+  return nullptr;
+}
+
+const DocSubsystem* SceneDocument::find_subsystem(const std::string& name) const {
+  for (const DocSubsystem& d : subsystems)
+    if (d.name == name) return &d;
+  return nullptr;
+}
+
+const DocSubsystem* SceneDocument::subsystem_of(const DocBlock& block) const {
+  const std::string prefix = kSubsystemTypePrefix;
+  if (block.type.rfind(prefix, 0) != 0) return nullptr;
+  return find_subsystem(block.type.substr(prefix.size()));
+}
+
 DocBlock* SceneDocument::find_block(const std::string& name) {
   for (auto& b : blocks)
     if (b.name == name) return &b;
@@ -112,6 +130,18 @@ std::string SceneDocument::unique_block_name(const std::string& stem) const {
   for (int i = 2;; ++i) {
     const std::string name = stem + std::to_string(i);
     if (!find_block(name)) return name;
+  }
+}
+
+}  // namespace dydp::gui
+
+namespace dydp::gui {
+
+std::string SceneDocument::unique_parameter_name(const std::string& stem) const {
+  if (!find_parameter(stem)) return stem;
+  for (int i = 2;; ++i) {
+    const std::string name = stem + std::to_string(i);
+    if (!find_parameter(name)) return name;
   }
 }
 

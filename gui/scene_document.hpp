@@ -66,6 +66,30 @@ struct DocConnection {
   bool operator==(const DocConnection&) const = default;
 };
 
+/// A subsystem definition of the scene (docs/scenes.md, "Subsystems"), included from a file or
+/// written inline. An instance (`type: subsystem.NAME`) is drawn as one block with the
+/// definition's ports; opening it shows the blocks inside. The GUI does not edit definitions.
+struct DocSubsystem {
+  std::string name;
+  std::string file;          ///< `{file: PATH}` as written; empty: inline
+  std::string inline_yaml;   ///< inline: the definition as read, written back with the same meaning
+  std::string source;        ///< the file the definition's body is read from
+  std::string error;         ///< not empty: the definition could not be read (ports unknown)
+  std::string description;
+  /// Parameters and their defaults (no items: the instance must give a value).
+  std::vector<std::pair<std::string, SceneValue>> parameters;
+  std::vector<std::pair<std::string, std::vector<std::string>>> inputs;  ///< port -> internal block.port
+  std::vector<std::pair<std::string, std::string>> outputs;              ///< port -> internal block.port
+  std::vector<DocBlock> blocks;             ///< inside, positions from its `layout:` or by signal flow
+  std::vector<DocConnection> connections;   ///< inside
+
+  const DocBlock* find_block(const std::string& name) const;
+  bool operator==(const DocSubsystem&) const = default;
+};
+
+/// The prefix of an instance's type: `subsystem.corner` names the definition `corner`.
+inline constexpr const char* kSubsystemTypePrefix = "subsystem.";
+
 struct SceneDocument {
   std::string header_comment;  ///< leading `#` lines of the file, kept on save
   std::string scene;
@@ -74,18 +98,24 @@ struct SceneDocument {
   Fields solver;
   std::vector<DocParameter> parameters;
   std::vector<std::string> sensitivities;
+  std::vector<DocSubsystem> subsystems;
   std::vector<DocBlock> blocks;
   std::vector<DocConnection> connections;
   std::vector<std::string> outputs;
 
   DocBlock* find_block(const std::string& name);
   const DocBlock* find_block(const std::string& name) const;
+  /// The definition an instance block refers to (null: not an instance, or no such definition).
+  const DocSubsystem* subsystem_of(const DocBlock& block) const;
+  const DocSubsystem* find_subsystem(const std::string& name) const;
   DocParameter* find_parameter(const std::string& name);
   const DocParameter* find_parameter(const std::string& name) const;
   /// The connection driving input `to`, or null.
   const DocConnection* driver_of(const PortRef& to) const;
   /// A block name not yet used, from a stem ("sine" -> "sine", "sine2", ...).
   std::string unique_block_name(const std::string& stem) const;
+  /// A scene parameter name not yet used, from a stem.
+  std::string unique_parameter_name(const std::string& stem) const;
   bool operator==(const SceneDocument&) const = default;
 };
 

@@ -10,6 +10,7 @@
 #include "engine/errors.hpp"
 #include "engine/output_writer.hpp"
 #include "gui/scene_document.hpp"
+#include "gui/subsystem_yaml.hpp"
 
 namespace dydp::gui {
 namespace {
@@ -176,6 +177,8 @@ SceneDocument parse_scene(const std::string& text, const std::string& file) {
       for (auto p : v) doc.parameters.push_back(read_parameter(r, p.first.Scalar(), p.second));
     } else if (key == "sensitivities") {
       doc.sensitivities = r.list(v, key);
+    } else if (key == "subsystems") {
+      doc.subsystems = read_subsystems(v, file);
     } else if (key == "blocks") {
       if (!v.IsMap()) r.fail(v, key, "expected a mapping of blocks");
       for (auto b : v) {
@@ -238,6 +241,7 @@ std::string write_scene(const SceneDocument& doc) {
   }
   if (!doc.sensitivities.empty())
     e << YAML::Key << "sensitivities" << YAML::Value << YAML::Flow << doc.sensitivities;
+  emit_subsystems(e, doc.subsystems);
   e << YAML::Key << "blocks" << YAML::Value << YAML::BeginMap;
   for (const DocBlock& b : doc.blocks) {
     e << YAML::Key << b.name << YAML::Value << YAML::Flow << YAML::BeginMap;

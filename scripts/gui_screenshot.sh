@@ -31,6 +31,8 @@ if [ ! -x "$gui" ]; then
 fi
 
 mkdir -p "$(dirname "$out")"
-QT_QPA_PLATFORM=xcb xvfb-run -a -s "-screen 0 1600x1000x24" \
-  "$gui" "$scene" --run --screenshot "$out" --size 1600x1000
+# 2000x1250: the whole sedan (car, four corner subsystems, rig, objectives) fitted with its port
+# names legible, and the objectives table wide enough for every digit.
+QT_QPA_PLATFORM=xcb xvfb-run -a -s "-screen 0 2000x1250x24" \
+  "$gui" "$scene" --run --screenshot "$out" --size 2000x1250
 echo "gui_screenshot: wrote $out"

@@ -27,7 +27,7 @@ int blocks_command(std::ostream& out) {
     bool complete = true;
     for (const auto& s : t->settings) {
       if (s.required) complete = false;
-      else defaults.set(s.name, {{s.default_value}, false, 0});
+      else defaults.set(s.name, {{s.default_value}, false, 0, {}});
     }
     if (!complete) {
       out << "    ports depend on the settings\n";

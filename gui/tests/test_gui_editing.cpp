@@ -1,6 +1,8 @@
 // Scenes built in the GUI by the calls a drag makes (palette drop, port-to-port wire, property
 // edits), saved, reopened and run in the worker thread; refusals with reasons; undo and redo;
 // validation errors marked on their block; cancelling a run.
+#include <QChart>
+#include <QChartView>
 #include <QMimeData>
 #include <QSignalSpy>
 #include <QTemporaryDir>
@@ -83,8 +85,9 @@ class GuiEditing : public QObject {
     QCOMPARE(QString::fromStdString(psi.name), QString("final"));
     QVERIFY(std::abs(psi.value - 3.0) < 1e-6);            // 2 s * 1.5
     QVERIFY(std::abs(psi.sensitivity.at(0) - 2.0) < 1e-6);  // d/dv
-    QCOMPARE(w.results()->objectives()->rowCount(), 1);
+    QCOMPARE(w.results()->objectives()->rowCount(), 2);  // psi and dpsi/dv
     QCOMPARE(w.results()->objectives()->item(0, 0)->text(), QString("final"));
+    QCOMPARE(w.results()->find_row("final", "dψ/dv"), 1);
     QCOMPARE(w.progress_bar()->value(), 1000);
 
     // An edit that is not saved yet runs too (from a temporary copy of the document).
@@ -92,6 +95,10 @@ class GuiEditing : public QObject {
     const RunOutcome edited = run_and_wait(w);
     QVERIFY(edited.status == RunOutcome::Status::finished);
     QVERIFY(std::abs(edited.result->objectives.front().value - 8.0) < 1e-6);
+    // The plot keeps the previous run beside the new one, for comparison.
+    const QList<QAbstractSeries*> series = w.results()->value_chart()->chart()->series();
+    QCOMPARE(series.size(), 2);
+    QVERIFY(series.at(1)->name().endsWith("(previous run)"));
   }
 
   void wires_with_mismatches_are_refused_with_the_reason() {
@@ -302,7 +309,9 @@ class GuiEditing : public QObject {
     const RunOutcome again = run_and_wait(w);
     QVERIFY(again.status == RunOutcome::Status::finished);
     QCOMPARE(again.result->objectives.front().sensitivity.size(), size_t(3));
-    QVERIFY(w.results()->objectives()->columnCount() == 5);  // name, psi, three directions
+    QCOMPARE(w.results()->objectives()->rowCount(), 4);  // psi and three directions, one row each
+    for (const char* p : {"mass", "stiffness", "damping"})
+      QVERIFY(w.results()->find_row("x_rms", QString("dψ/d") + p) >= 0);
   }
 };
 

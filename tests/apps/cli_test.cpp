@@ -567,7 +567,7 @@ TEST_F(Cli, RefusedPointsAheadStopTheRunAtTheSmallestStep) {
   const Result r = dydp("run " + quote(src.string()) + " --no-sens --out " + quote((dir_ / "spin").string()));
   EXPECT_EQ(r.status, 1) << r.err;
   EXPECT_NE(r.err.find("t = 2.2"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("block damper_fr"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("block corner_fr.damper"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("stroke beyond the chambers' length"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "spin" / "signals.csv"));
 }

@@ -64,6 +64,20 @@ inline std::filesystem::path source_path(const std::string& relative) {
   return std::filesystem::path(DYDP_SOURCE_DIR) / relative;
 }
 
+/// The text of a scene file with its subsystem includes (`{file: PATH}`) made absolute, so that
+/// an edited copy written to another folder includes the same subsystem files.
+inline std::string scene_copy_text(const std::filesystem::path& scene) {
+  std::string text = read_text(scene);
+  const std::string key = "{file: ";
+  for (size_t at = text.find(key); at != std::string::npos; at = text.find(key, at + key.size())) {
+    const size_t begin = at + key.size(), end = text.find('}', begin);
+    const std::filesystem::path rel = text.substr(begin, end - begin);
+    if (rel.is_absolute()) continue;
+    text.replace(begin, end - begin, (scene.parent_path() / rel).lexically_normal().string());
+  }
+  return text;
+}
+
 /// A column of a CSV file the program wrote, by name; throws when it is missing.
 inline const std::vector<double>& column(const engine::CsvFile& csv, const std::string& name) {
   const int c = csv.find(name);

@@ -54,7 +54,7 @@ TEST_F(ReadmeCommands, MainJobWithReport) {
   std::string scene = source_path("scenarios/fourposter_comfort.yaml").string();
   double stop = 20.0;
   if (DYDP_SANITIZED) {
-    std::string text = read_text(scene);
+    std::string text = scene_copy_text(scene);
     text = replaced(text, "stop: 20.0", "stop: 3.0");
     while (text.find("window: [2.0, 20.0]") != std::string::npos)
       text.replace(text.find("window: [2.0, 20.0]"), 19, "window: [1.0, 3.0]");

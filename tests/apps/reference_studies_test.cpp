@@ -13,17 +13,14 @@
 #include <string>
 #include <vector>
 
+#include "tests/apps/dydp_process.hpp"
 #include "tests/blocks/scene_helpers.hpp"
 
 namespace dydp::test {
 namespace {
 
-std::string read_scenario(const std::string& name) {
-  std::ifstream in(std::string(DYDP_SOURCE_DIR) + "/scenarios/" + name);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+/// A scene of scenarios/, its subsystem includes made absolute for a copy written elsewhere.
+std::string read_scenario(const std::string& name) { return scene_copy_text(source_path("scenarios/" + name)); }
 
 /// Replaces every occurrence of `from` in `text`; fails the test if there is none.
 std::string replace(std::string text, const std::string& from, const std::string& to) {

@@ -51,7 +51,7 @@ const StressCase kCases[] = {
     {"bulk_modulus_10x", true, {}},
     {"bulk_modulus_100x", true, {}},
     {"cornering_saturation", true, {}},
-    {"cornering_wheelspin", false, {2.2, 2.35, "damper_fr", "stroke beyond the chambers' length"}},
+    {"cornering_wheelspin", false, {2.2, 2.35, "corner_fr.damper", "stroke beyond the chambers' length"}},
     {"current_hard", true, {}},
     {"current_soft", true, {}},
     {"pothole_lift_off", true, {}},
@@ -147,7 +147,7 @@ class StressClaims : public DydpProcessTest {
 
   /// Runs a copy of a stress scene (edited by `edit`) without sensitivities; its signals.
   engine::CsvFile run_copy(const std::string& name, const std::function<std::string(std::string)>& edit) {
-    const std::string scene = write(name + ".yaml", edit(read_text(stress_scene(name))));
+    const std::string scene = write(name + ".yaml", edit(scene_copy_text(stress_scene(name))));
     const fs::path out = dir_ / name;
     const ProcessResult r = dydp("run " + quote(scene) + " --no-sens --out " + quote(out.string()));
     EXPECT_EQ(r.status, 0) << r.err;
@@ -168,7 +168,7 @@ TEST_F(StressClaims, CorneringSaturationCoastsAndSaturatesAsItsHeaderSays) {
   double slip_min = INFINITY, slip_max = 0, acc = 0;
   int n = 0;
   for (size_t k = 0; k < t.size(); ++k) {
-    const double slip = std::fabs(column(csv, "mf_fl.slip_angle")[k]);
+    const double slip = std::fabs(column(csv, "corner_fl.mf.slip_angle")[k]);
     if (t[k] >= 1.5) slip_min = std::min(slip_min, slip), slip_max = std::max(slip_max, slip);
     if (t[k] >= 4.0) acc += column(csv, "car.body_acc_y")[k], ++n;
   }
@@ -187,7 +187,7 @@ TEST_F(StressClaims, CorneringWheelspinSpinsAtTwoSecondsAsItsHeaderSays) {
     return s;
   });
   EXPECT_NEAR(std::fabs(value_at(csv, "car.yaw_rate", 2.0)), 1.4, 0.14);
-  EXPECT_NEAR(std::fabs(value_at(csv, "mf_rl.slip_angle", 2.0)), 0.49, 0.05);
+  EXPECT_NEAR(std::fabs(value_at(csv, "corner_rl.mf.slip_angle", 2.0)), 0.49, 0.05);
   EXPECT_NEAR(std::fabs(value_at(csv, "car.body_vy", 2.0)), 10.0, 1.0);
 }
 
