@@ -164,6 +164,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   std::vector<EmittedFunction> dynamics, residual_tangent, kinematics, sensors;
   dynamics.push_back(tangent(name + "_mass", *lists.inertial, {lists.qdd}, /*with_primal=*/false));
   dynamics.push_back(plain(name + "_residual", *lists.residual));
+  if (lists.mass_matrix) dynamics.push_back(plain(name + "_mass_matrix", *lists.mass_matrix));
   residual_tangent.push_back(tangent(name + "_residual_tangent", *lists.residual, all_seeded));
   auto part = [&](const std::string& label, const EquationList& list, std::size_t from, std::size_t to) {
     EquationList alone(list.context());
@@ -255,6 +256,15 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
     }
   }
   d += number_array("int", "jacobian_nonzero", jacobian_nonzero);
+  // the mass matrix's entries: (row, col) of each output of NAME_mass_matrix, read off its names
+  std::vector<int> mass_rows, mass_cols;
+  for (const auto& o : lists.mass_matrix ? lists.mass_matrix->outputs() : std::vector<symbolic::Output>{}) {
+    const auto comma = o.name.find(',');
+    mass_rows.push_back(std::stoi(o.name.substr(2, comma - 2)));
+    mass_cols.push_back(std::stoi(o.name.substr(comma + 1)));
+  }
+  d += number_array("int", "mass_rows", mass_rows);
+  d += number_array("int", "mass_cols", mass_cols);
   d += "}  // namespace\n\n";
   d += "// independent coordinates" + std::string(automatic ? " (automatic, pivoted QR of J at q0)" : "") + ":";
   for (const auto& u : result.independent) d += " " + u;
@@ -268,7 +278,9 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += "    " + name + "_mass, " + name + "_residual, " + name + "_residual_tangent, " + name + "_constraints,\n";
   d += "    " + name + "_velocity_constraints_tangent, " + name + "_sensors, " + name + "_sensors_tangent,\n";
   d += "    " + std::to_string(model.load_input_count()) + ", load_names, load_widths, sensor_units,\n";
-  d += "    jacobian_nonzero, " + name + "_constraints_tangent};\n\n";
+  d += "    jacobian_nonzero, " + name + "_constraints_tangent,\n";
+  d += "    " + std::to_string(mass_rows.size()) + ", mass_rows, mass_cols, " +
+       (lists.mass_matrix ? name + "_mass_matrix" : std::string("nullptr")) + "};\n\n";
   d += "}  // namespace dydp::generated\n";
   write_atomically(options.out_dir / (name + "_model.cpp"), d);
   return result;

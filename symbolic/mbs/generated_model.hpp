@@ -59,6 +59,14 @@ struct GeneratedModel {
   // m x n row-major: 0 where J is zero whatever the state (a joint that does not move the cut).
   const int* jacobian_nonzero;
   GeneratedTangent constraints_tangent;  // h (m) and its tangent: dh for dq (cheaper than h, J qd)
+  // M by composite inertias: mass_matrix writes mass_entries values, M(mass_rows[k],
+  // mass_cols[k]) = M(mass_cols[k], mass_rows[k]) = out[k]; the other entries are zero (joints
+  // neither of which carries the other). Null (mass_entries 0) for a tree too deep for it
+  // (chain200): M comes from `mass` then.
+  int mass_entries;
+  const int* mass_rows;
+  const int* mass_cols;
+  GeneratedFunction mass_matrix;
 };
 
 }  // namespace dydp::mbs

@@ -6,6 +6,7 @@
 #include "symbolic/mbs/newton_euler.hpp"
 
 #include <array>
+#include <functional>
 #include <map>
 
 #include "symbolic/compact.hpp"
@@ -92,6 +93,12 @@ class Generator {
       return o;
     };
     out_.inertial = std::make_unique<EquationList>(symbolic::eliminate(with_outputs(*all_, outputs("Mqdd", inertial))));
+    if (mass_entry_count() <= kMassEntriesPerCoordinate * static_cast<std::size_t>(m_.coordinates())) {
+      std::vector<Output> o;
+      for (const MassEntry& e : mass_matrix())
+        o.push_back({"M[" + std::to_string(e.row) + "," + std::to_string(e.col) + "]", e.value.id()});
+      out_.mass_matrix = merged(o, {}, o);
+    }
 
     // The constraint kinematics: h and J from the relative kinematics of the cut points (a joint
     // turns a point by e x r: constraint_jacobian()), J qd from them. The residual's constraint
@@ -452,6 +459,127 @@ class Generator {
       }
     }
     return q_force;
+  }
+
+  // A symmetric 3 x 3 matrix (rotational inertia) by its six entries.
+  struct Sym {
+    Expr xx, yy, zz, xy, xz, yz;
+    Expr at(int a, int b) const {
+      if (a > b) std::swap(a, b);
+      if (a == b) return a == 0 ? xx : a == 1 ? yy : zz;
+      return a == 0 ? (b == 1 ? xy : xz) : yz;
+    }
+    V3 apply(const V3& v) const {
+      return {{xx * v[0] + xy * v[1] + xz * v[2], xy * v[0] + yy * v[1] + yz * v[2], xz * v[0] + yz * v[1] + zz * v[2]}};
+    }
+  };
+  // The inertia of a subtree about a joint frame's origin, in its components: mass, first
+  // moment h = sum m c, rotational inertia J about the origin.
+  struct Composite {
+    Expr mass;
+    V3 moment;
+    Sym inertia;
+  };
+  Sym sym_from(const std::function<Expr(int, int)>& entry) {
+    return {entry(0, 0), entry(1, 1), entry(2, 2), entry(0, 1), entry(0, 2), entry(1, 2)};
+  }
+  // Composite k moved into its parent's frame: rotation R (rotate(k, .)), origin r there:
+  // h' = R h + m r, J' = R J R^T - (h' r^T + r h'^T) + (2 r.h' + m |r|^2) E - m r r^T, with
+  // R h the moment about O_k and h' about the parent's origin (of R h + m r, the R h part).
+  Composite to_parent(int k, const Composite& c) {
+    const V3 r = offset_[k];
+    const V3 h = rotate(k, c.moment);  // about O_k, parent components
+    std::array<V3, 3> columns;          // R J R^T by columns: R (J (R^T e_c))
+    for (int col = 0; col < 3; ++col) columns[col] = rotate(k, c.inertia.apply(rotate_back(k, unit(col))));
+    const Expr rh = dot(r, h), rr = dot(r, r);
+    const Expr diagonal = ctx_->constant(2.0) * rh + c.mass * rr;
+    const Sym J = sym_from([&](int a, int b) {
+      Expr e = columns[b][a] - (h[a] * r[b] + r[a] * h[b]) - c.mass * (r[a] * r[b]);
+      return a == b ? e + diagonal : e;
+    });
+    return {c.mass, h + c.mass * r, J};
+  }
+  Composite body_composite(int k) {
+    const Joint& j = m_.joints[k];
+    if (j.body < 0) return {ctx_->zero(), zero3(), {ctx_->zero(), ctx_->zero(), ctx_->zero(), ctx_->zero(), ctx_->zero(), ctx_->zero()}};
+    const Body& b = m_.bodies[j.body];
+    const Expr mass = val(b.mass);
+    const V3 c = vec(b.com);
+    const Sym I{val(b.inertia[0]), val(b.inertia[1]), val(b.inertia[2]), val(b.inertia[3]), val(b.inertia[4]), val(b.inertia[5])};
+    const Expr cc = dot(c, c);
+    // about the frame origin: I_G + m (|c|^2 E - c c^T)
+    const Sym J = sym_from([&](int a, int e) {
+      Expr v = I.at(a, e) - mass * (c[a] * c[e]);
+      return a == e ? v + mass * cc : v;
+    });
+    return {mass, mass * c, J};
+  }
+
+  // The mass matrix by composite inertias: the subtrees' inertias backward, then for each joint
+  // i the force and torque its unit acceleration needs on its subtree (revolute axis e:
+  // F = e x h, N = J e; prismatic: F = m e, N = h x e), carried to every ancestor k, where
+  // M(i, k) is k's axis against them. Entries of two joints neither of which carries the other
+  // are zero and not computed (two suspension corners). One entry (i, k) per joint i and k = i
+  // or an ancestor of i: M(i, k) = M(k, i).
+  struct MassEntry {
+    int row, col;
+    Expr value;
+  };
+  // Entries of the composite-inertia M: one per joint and each of its ancestors. Their code grows
+  // like n times the tree's mean depth; past kMassEntriesPerCoordinate per coordinate (a long
+  // chain: chain200 has 20 100 entries, 321 k operations) M stays the inertial pass's tangent,
+  // whose code is one pass whatever the number of columns.
+  static constexpr std::size_t kMassEntriesPerCoordinate = 16;
+  std::size_t mass_entry_count() const {
+    std::size_t count = 0;
+    for (int i = 0; i < m_.coordinates(); ++i)
+      for (int k = i; k >= 0; k = m_.joints[k].parent) ++count;
+    return count;
+  }
+  std::vector<MassEntry> mass_matrix() {
+    const int n = m_.coordinates();
+    std::vector<Composite> composite(n);
+    for (const int k : m_.order) composite[k] = body_composite(k);
+    for (auto it = m_.order.rbegin(); it != m_.order.rend(); ++it) {
+      const int k = *it;
+      Composite& c = composite[k];
+      const std::string tag = "CM" + std::to_string(k + 1);
+      c.mass = all_->assign(tag + "_m", c.mass);
+      c.moment = assign(tag + "_h", 0, c.moment);
+      c.inertia = sym_from([&](int a, int b) {
+        return all_->assign(tag + "_J" + std::to_string(a + 1) + std::to_string(b + 1), c.inertia.at(a, b));
+      });
+      const int parent = m_.joints[k].parent;
+      if (parent < 0) continue;
+      const Composite moved = to_parent(k, c);
+      Composite& p = composite[parent];
+      p.mass = p.mass + moved.mass;
+      p.moment = p.moment + moved.moment;
+      p.inertia = sym_from([&](int a, int b) { return p.inertia.at(a, b) + moved.inertia.at(a, b); });
+    }
+    std::vector<MassEntry> entries;
+    for (int i = 0; i < n; ++i) {
+      const Composite& c = composite[i];
+      const V3 e = joint_axis(i);
+      const bool revolute = is_revolute(m_.joints[i].type);
+      V3 F = revolute ? cross(e, c.moment) : c.mass * e;
+      V3 N = revolute ? c.inertia.apply(e) : cross(c.moment, e);
+      auto entry = [&](int k) {
+        const V3 axis = joint_axis(k);
+        const Expr v = is_revolute(m_.joints[k].type) ? dot(axis, N) : dot(axis, F);
+        entries.push_back({i, k, all_->assign("MM" + std::to_string(i + 1) + "_" + std::to_string(k + 1), v)});
+      };
+      entry(i);
+      for (int k = i; m_.joints[k].parent >= 0; k = m_.joints[k].parent) {
+        F = rotate(k, F);
+        N = rotate(k, N) + cross(offset_[k], F);
+        const std::string tag = std::to_string(i + 1) + "_" + std::to_string(k + 1);
+        F = assign("MF" + tag + "_", 0, F);
+        N = assign("MN" + tag + "_", 0, N);
+        entry(m_.joints[k].parent);
+      }
+    }
+    return entries;
   }
 
   // Every cut's equations are written in the frame of the nearest joint frame that carries both

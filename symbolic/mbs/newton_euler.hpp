@@ -20,6 +20,10 @@ struct ModelLists {
   // Outputs M qdd of the inertial pass (qd = 0, no gravity, no loads): seeded on qdd, its
   // tangent gives the columns of M.
   std::unique_ptr<symbolic::EquationList> inertial;
+  // The entries of M by composite inertias: outputs named M[i,k] (k = i and every ancestor of
+  // joint i), the structurally nonzero entries; null for trees too deep for it (see
+  // newton_euler.cpp), which use the inertial pass's tangent.
+  std::unique_ptr<symbolic::EquationList> mass_matrix;
   // r = M qdd + c - J^T lam (n outputs), then the constraint accelerations J qdd + Jdot qd (m),
   // the cut points' relative accelerations from the full pass (Jdot qd: the same at qdd = 0).
   std::unique_ptr<symbolic::EquationList> residual;

@@ -40,6 +40,15 @@ inline Matrix generated_mass(const GeneratedModel& g, const Args& a) {
   return Eigen::Map<Matrix>(dout.data(), n, n);
 }
 
+// M from the composite-inertia entries (zero elsewhere); the model must have them.
+inline Matrix generated_mass_matrix(const GeneratedModel& g, const Args& a) {
+  std::vector<double> out(std::max(1, g.mass_entries));
+  g.mass_matrix(a.q.data(), a.qd.data(), a.qdd.data(), a.lam.data(), a.inp.data(), a.p.data(), out.data());
+  Matrix M = Matrix::Zero(g.n, g.n);
+  for (int e = 0; e < g.mass_entries; ++e) M(g.mass_rows[e], g.mass_cols[e]) = M(g.mass_cols[e], g.mass_rows[e]) = out[e];
+  return M;
+}
+
 inline Vector generated_outputs(GeneratedFunction f, int size, const Args& a) {
   std::vector<double> out(std::max(size, 1));
   f(a.q.data(), a.qd.data(), a.qdd.data(), a.lam.data(), a.inp.data(), a.p.data(), out.data());
