@@ -125,9 +125,8 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
     }
   }
 
-  // M [B beta]: M's nonzero entries by composite inertias applied to [B beta], or (a tree too deep
-  // for those, mass_matrix null) the inertial pass seeded on those accelerations (nu + 1
-  // directions): M qdd for qdd = B udd + beta is all we need.
+  // M [B beta] from the inertial pass seeded on those accelerations (nu + 1 directions; M
+  // itself, n directions, is never formed): M qdd for qdd = B udd + beta is all we need.
   const int k = nu + (m > 0 ? 1 : 0);
   // kept in r between calls: a large tree's n x n blocks would be fresh pages at every call
   r.seeds.setZero(n, k);
@@ -135,32 +134,12 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
     r.seeds.row(f_[a]).head(nu) = r.B.row(a);
     if (m > 0) r.seeds(f_[a], nu) = beta[a];
   }
+  // (M's composite-inertia entries, NAME_mass_matrix, applied to [B beta] entry by entry cost the
+  // sedan as much as the tangent's 14 extra directions: udd 322 k instructions against 304 k,
+  // docs/performance.md; the tangent is kept.)
+  std::vector<double> out(n);
   r.MB.resize(n, k);
-  if (model_.mass_matrix) {
-    // M's structurally nonzero entries by composite inertias, applied entry by entry to the
-    // seeds held row-contiguous (seeds_t: row j of [B beta] at j*k), into MB likewise
-    r.mass_values.resize(std::max(1, model_.mass_entries));
-    model_.mass_matrix(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, r.mass_values.data());
-    r.seeds_t.resize(static_cast<std::size_t>(n) * k);
-    r.MB_t.assign(static_cast<std::size_t>(n) * k, 0.0);
-    for (int j = 0; j < n; ++j)
-      for (int c = 0; c < k; ++c) r.seeds_t[j * k + c] = r.seeds(j, c);
-    const double* seeds_t = r.seeds_t.data();
-    double* mb_t = r.MB_t.data();
-    using Row = Eigen::Map<Vector>;
-    using ConstRow = Eigen::Map<const Vector>;
-    for (int e = 0; e < model_.mass_entries; ++e) {
-      const int i = model_.mass_rows[e], j = model_.mass_cols[e];
-      const double v = r.mass_values[e];
-      Row(mb_t + i * k, k).noalias() += v * ConstRow(seeds_t + j * k, k);
-      if (i != j) Row(mb_t + j * k, k).noalias() += v * ConstRow(seeds_t + i * k, k);
-    }
-    for (int i = 0; i < n; ++i)
-      for (int c = 0; c < k; ++c) r.MB(i, c) = mb_t[i * k + c];
-  } else {
-    std::vector<double> out(n);
-    model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, k, r.seeds.data(), out.data(), r.MB.data());
-  }
+  model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, k, r.seeds.data(), out.data(), r.MB.data());
 
   // a tree (no constraints, u in coordinate order): B = I, M B = M, and the products would cost
   // two dense n^3 products

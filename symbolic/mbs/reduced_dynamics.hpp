@@ -32,8 +32,6 @@ class ReducedDynamics {
     Matrix B;                                     // free coordinates x nu
     Eigen::LLT<Matrix> reduced;                   // B^T M_ff B
     Matrix seeds, MBf;                            // work space: [B beta] over q, M_ff B
-    std::vector<double> mass_values;              // work space: M's entries (composite inertias)
-    std::vector<double> seeds_t, MB_t;            // work space: [B beta] and M [B beta] by rows
     int newton_iterations = 0;
   };
 
