@@ -1,8 +1,11 @@
-// Block-diagonal LU (see block_lu.hpp): components by union-find over rows and columns.
+// Block-diagonal LU (see block_lu.hpp): components by union-find over rows and columns, each
+// block factored with partial pivoting by Doolittle's elimination in place.
 #include "symbolic/mbs/block_lu.hpp"
 
+#include <cmath>
 #include <numeric>
 #include <stdexcept>
+#include <utility>
 
 namespace dydp::mbs {
 
@@ -10,6 +13,7 @@ void BlockLU::set_pattern(const Eigen::Matrix<char, Eigen::Dynamic, Eigen::Dynam
   const int m = static_cast<int>(nonzero.rows());
   if (nonzero.cols() != m) throw std::invalid_argument("BlockLU: the pattern must be square");
   size_ = m;
+  work_.assign(2 * std::max(1, m), 0.0);
   // nodes 0..m-1 rows, m..2m-1 columns
   std::vector<int> parent(2 * m);
   std::iota(parent.begin(), parent.end(), 0);
@@ -41,42 +45,120 @@ void BlockLU::set_pattern(const Eigen::Matrix<char, Eigen::Dynamic, Eigen::Dynam
     }
     break;
   }
+  for (Block& b : blocks_) {
+    const std::size_t k = b.rows.size();
+    b.lu.assign(k * k, 0.0);
+    b.pivot.assign(k, 0);
+  }
 }
 
-void BlockLU::compute(const Matrix& A) {
-  if (A.rows() != size_ || A.cols() != size_) throw std::invalid_argument("BlockLU: size differs from the pattern");
+bool BlockLU::factor(Block& b) {
+  const int k = static_cast<int>(b.rows.size());
+  double* a = b.lu.data();
+  bool regular = true;
+  for (int j = 0; j < k; ++j) {
+    int p = j;
+    for (int i = j + 1; i < k; ++i)
+      if (std::abs(a[j * k + i]) > std::abs(a[j * k + p])) p = i;
+    b.pivot[j] = p;
+    if (p != j)
+      for (int c = 0; c < k; ++c) std::swap(a[c * k + j], a[c * k + p]);
+    const double d = a[j * k + j];
+    if (d == 0.0 || !std::isfinite(d)) {
+      regular = false;
+      continue;
+    }
+    for (int i = j + 1; i < k; ++i) a[j * k + i] /= d;
+    for (int c = j + 1; c < k; ++c) {
+      const double f = a[c * k + j];
+      if (f == 0.0) continue;
+      for (int i = j + 1; i < k; ++i) a[c * k + i] -= a[j * k + i] * f;
+    }
+  }
+  // the exchanges as one permutation of the block's rows: (P b)_i = b[pivoted_rows[i]]
+  b.pivoted_rows = b.rows;
+  for (int j = 0; j < k; ++j) std::swap(b.pivoted_rows[j], b.pivoted_rows[b.pivot[j]]);
+  return regular;
+}
+
+bool BlockLU::compute(const Matrix& A) {
+  std::vector<int> all(size_);
+  std::iota(all.begin(), all.end(), 0);
+  return compute(A, all);
+}
+
+bool BlockLU::compute(const Matrix& A, const std::vector<int>& cols) {
+  if (A.rows() != size_ || static_cast<int>(cols.size()) != size_)
+    throw std::invalid_argument("BlockLU: size differs from the pattern");
+  bool regular = true;
   for (Block& b : blocks_) {
     const int k = static_cast<int>(b.rows.size());
-    b.work.resize(k, k);
-    for (int i = 0; i < k; ++i)
-      for (int j = 0; j < k; ++j) b.work(i, j) = A(b.rows[i], b.cols[j]);
-    b.lu.compute(b.work);
+    for (int c = 0; c < k; ++c)
+      for (int i = 0; i < k; ++i) b.lu[c * k + i] = A(b.rows[i], cols[b.cols[c]]);
+    regular = factor(b) && regular;
+  }
+  return regular;
+}
+
+void BlockLU::solve(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs, double* x, Eigen::Index ldx) const {
+  double* __restrict t = work_.data();
+  double* __restrict z = t + size_;
+  for (Eigen::Index c = 0; c < nrhs; ++c) {
+    const double* bc = rhs + c * ldb;
+    for (int i = 0; i < size_; ++i) t[i] = bc[i];
+    double* xc = x + c * ldx;
+    for (const Block& b : blocks_) {
+      const int k = static_cast<int>(b.rows.size());
+      const double* __restrict a = b.lu.data();
+      const int* __restrict from = b.pivoted_rows.data();
+      for (int i = 0; i < k; ++i) z[i] = t[from[i]];  // P b
+      for (int j = 0; j < k; ++j)                      // L y = P b
+        for (int i = j + 1; i < k; ++i) z[i] -= a[j * k + i] * z[j];
+      for (int j = k - 1; j >= 0; --j) {               // U x = y
+        z[j] /= a[j * k + j];
+        for (int i = 0; i < j; ++i) z[i] -= a[j * k + i] * z[j];
+      }
+      const int* __restrict to = b.cols.data();
+      for (int i = 0; i < k; ++i) xc[to[i]] = z[i];
+    }
   }
 }
 
-BlockLU::Matrix BlockLU::solve(const Matrix& rhs) const {
-  Matrix x(size_, rhs.cols());
-  for (const Block& b : blocks_) {
-    const int k = static_cast<int>(b.rows.size());
-    Matrix part(k, rhs.cols());
-    for (int i = 0; i < k; ++i) part.row(i) = rhs.row(b.rows[i]);
-    const Matrix y = b.lu.solve(part);
-    for (int i = 0; i < k; ++i) x.row(b.cols[i]) = y.row(i);
+void BlockLU::transpose_solve(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs, double* x,
+                              Eigen::Index ldx) const {
+  // A^T y = b with P A = L U: U^T w = b, L^T v = w, y = P^T v
+  double* __restrict t = work_.data();
+  double* __restrict z = t + size_;
+  for (Eigen::Index c = 0; c < nrhs; ++c) {
+    const double* bc = rhs + c * ldb;
+    for (int i = 0; i < size_; ++i) t[i] = bc[i];
+    double* xc = x + c * ldx;
+    for (const Block& b : blocks_) {
+      const int k = static_cast<int>(b.rows.size());
+      const double* __restrict a = b.lu.data();
+      const int* __restrict from = b.cols.data();
+      for (int i = 0; i < k; ++i) z[i] = t[from[i]];
+      for (int j = 0; j < k; ++j) {
+        for (int i = 0; i < j; ++i) z[j] -= a[j * k + i] * z[i];
+        z[j] /= a[j * k + j];
+      }
+      for (int j = k - 1; j >= 0; --j)
+        for (int i = j + 1; i < k; ++i) z[j] -= a[j * k + i] * z[i];
+      const int* __restrict to = b.pivoted_rows.data();
+      for (int i = 0; i < k; ++i) xc[to[i]] = z[i];
+    }
   }
+}
+
+BlockLU::Matrix BlockLU::solve(const Matrix& b) const {
+  Matrix x(size_, b.cols());
+  solve(b.data(), b.rows(), b.cols(), x.data(), size_);
   return x;
 }
 
-BlockLU::Matrix BlockLU::transpose_solve(const Matrix& rhs) const {
-  Matrix x(size_, rhs.cols());
-  for (const Block& b : blocks_) {
-    const int k = static_cast<int>(b.rows.size());
-    Eigen::VectorXd part(k);
-    for (Eigen::Index c = 0; c < rhs.cols(); ++c) {
-      for (int i = 0; i < k; ++i) part[i] = rhs(b.cols[i], c);
-      const Eigen::VectorXd y = b.lu.transpose().solve(part);
-      for (int i = 0; i < k; ++i) x(b.rows[i], c) = y[i];
-    }
-  }
+BlockLU::Matrix BlockLU::transpose_solve(const Matrix& b) const {
+  Matrix x(size_, b.cols());
+  transpose_solve(b.data(), b.rows(), b.cols(), x.data(), size_);
   return x;
 }
 

@@ -25,17 +25,12 @@ ReducedDynamics::ReducedDynamics(const GeneratedModel& model) : model_(model), p
   for (int i = 0; i < model.m; ++i)
     for (int k = 0; k < model.m; ++k) pattern(i, k) = model.jacobian_nonzero[i * model.n + v_[k]] != 0;
   jv_blocks_.set_pattern(pattern);
+  for (int j : f_) {
+    const auto iu = std::find(u_.begin(), u_.end(), j);
+    free_place_.push_back(iu != u_.end() ? static_cast<int>(iu - u_.begin())
+                                         : -1 - static_cast<int>(std::find(v_.begin(), v_.end(), j) - v_.begin()));
+  }
 }
-
-namespace {
-
-Eigen::MatrixXd columns(const Eigen::MatrixXd& A, const std::vector<int>& cols) {
-  Eigen::MatrixXd C(A.rows(), static_cast<Eigen::Index>(cols.size()));
-  for (std::size_t i = 0; i < cols.size(); ++i) C.col(i) = A.col(cols[i]);
-  return C;
-}
-
-}  // namespace
 
 void ReducedDynamics::solve(const double* u, const double* ud, const double* inputs, const double* p,
                             const Vector& guess, Result& r) const {
@@ -47,10 +42,11 @@ void ReducedDynamics::solve_kinematics(const double* u, const double* ud, const 
                                        const Vector& guess, Result& r) const {
   const int n = model_.n, m = model_.m, nu = this->nu();
   const double* p = params(p_in);
-  std::vector<double> lam_zero(std::max(1, m), 0.0);
+  Result::Work& w = r.work;
+  w.lam_zero.assign(std::max(1, m), 0.0);
   r.q = guess;
-  r.qd = Vector::Zero(n);
-  r.qdd = Vector::Zero(n);
+  r.qd.setZero(n);
+  r.qdd.setZero(n);
   for (int i = 0; i < nu; ++i) {
     r.q[u_[i]] = u[i];
     r.qd[u_[i]] = ud[i];
@@ -63,29 +59,32 @@ void ReducedDynamics::solve_kinematics(const double* u, const double* ud, const 
   const double* in = model_.inputs ? inputs : pad_.data();
 
   // Constraints: h, J.
-  std::vector<double> hj(m + m * n + 1);
+  w.hj.resize(m + m * n + 1);
   r.J.resize(m, n);
   auto evaluate_constraints = [&] {
-    model_.constraints(r.q.data(), r.qd.data(), r.qdd.data(), lam_zero.data(), in, p, hj.data());
+    model_.constraints(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, w.hj.data());
     for (int i = 0; i < m; ++i)
-      for (int j = 0; j < n; ++j) r.J(i, j) = hj[m + i * n + j];
+      for (int j = 0; j < n; ++j) r.J(i, j) = w.hj[m + i * n + j];
   };
   r.newton_iterations = 0;
   if (m > 0) {
+    if (r.Jv.size() != m) r.Jv = jv_blocks_;
+    w.fv.resize(m);
     for (;;) {
       evaluate_constraints();
       double norm = 0.0;
-      for (int i = 0; i < m; ++i) norm = std::max(norm, std::abs(hj[i]));
-      if (r.Jv.size() != m) r.Jv = jv_blocks_;
-      r.Jv.compute(columns(r.J, v_));
+      for (int i = 0; i < m; ++i) norm = std::max(norm, std::abs(w.hj[i]));
+      if (!r.Jv.compute(r.J, v_) && std::isfinite(norm))
+        throw std::runtime_error(std::string(model_.name) + ": the constraint Jacobian is singular");
       if (norm < 1e-13) break;
       if (++r.newton_iterations > 30 || !std::isfinite(norm))
         throw std::runtime_error(std::string(model_.name) + ": Newton-Raphson on the constraints did not converge");
-      const Vector dv = r.Jv.solve(Eigen::Map<const Vector>(hj.data(), m));
-      for (int i = 0; i < m; ++i) r.q[v_[i]] -= dv[i];
+      r.Jv.solve(w.hj.data(), m, 1, w.fv.data(), m);
+      for (int i = 0; i < m; ++i) r.q[v_[i]] -= w.fv[i];
     }
-    const Vector vd = r.Jv.solve(-(r.J * r.qd));
-    for (int i = 0; i < m; ++i) r.qd[v_[i]] = vd[i];
+    w.fv.noalias() = r.J * r.qd;  // Jv vd = -J qd (vd still zero in qd)
+    r.Jv.solve(w.fv.data(), m, 1, w.fv.data(), m);
+    for (int i = 0; i < m; ++i) r.qd[v_[i]] = -w.fv[i];
   }
 }
 
@@ -93,35 +92,36 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   const int n = model_.n, m = model_.m, nu = this->nu();
   const double* p = params(p_in);
   const double* lam0 = pad_.data();
-  std::vector<double> lam_zero(std::max(1, m), 0.0);
+  Result::Work& w = r.work;
+  w.lam_zero.assign(std::max(1, m), 0.0);
   const double* in = model_.inputs ? inputs : pad_.data();
-  r.qdd = Vector::Zero(n);
+  r.qdd.setZero(n);
   for (std::size_t i = 0; i < d_.size(); ++i) r.qdd[d_[i]] = inputs[model_.load_inputs + 3 * i + 2];
 
   // c (with the driven accelerations) and the constraint bias.
-  std::vector<double> res(n + m);
-  model_.residual(r.q.data(), r.qd.data(), r.qdd.data(), lam_zero.data(), in, p, res.data());
-  const Vector c = Eigen::Map<const Vector>(res.data(), n);
-  const Vector a0 = Eigen::Map<const Vector>(res.data() + n, m);
+  w.res.resize(n + m);
+  model_.residual(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, w.res.data());
+  const Eigen::Map<const Vector> c(w.res.data(), n), a0(w.res.data() + n, m);
 
   const int nf = static_cast<int>(f_.size());
   // B over the free coordinates: rows u (identity) and v (-Jv^-1 Ju).
-  r.B = Matrix::Zero(nf, nu);
-  Vector beta = Vector::Zero(nf);
-  Matrix Bv, beta_v;
+  r.B.setZero(nf, nu);
+  w.beta.setZero(nf);
   if (m > 0) {
-    Bv = -r.Jv.solve(columns(r.J, u_));
-    beta_v = -r.Jv.solve(a0);
+    w.Ju.resize(m, nu);
+    for (int i = 0; i < nu; ++i) w.Ju.col(i) = r.J.col(u_[i]);
+    w.Bv.resize(m, nu);
+    r.Jv.solve(w.Ju.data(), m, nu, w.Bv.data(), m);
+    w.beta_v.resize(m, 1);
+    r.Jv.solve(a0.data(), m, 1, w.beta_v.data(), m);
   }
   for (int a = 0; a < nf; ++a) {
-    const int j = f_[a];
-    const auto iu = std::find(u_.begin(), u_.end(), j);
-    if (iu != u_.end()) {
-      r.B(a, iu - u_.begin()) = 1.0;
+    const int place = free_place_[a];
+    if (place >= 0) {
+      r.B(a, place) = 1.0;
     } else {
-      const int iv = static_cast<int>(std::find(v_.begin(), v_.end(), j) - v_.begin());
-      r.B.row(a) = Bv.row(iv);
-      beta[a] = beta_v(iv, 0);
+      r.B.row(a) = -w.Bv.row(-1 - place);
+      w.beta[a] = -w.beta_v(-1 - place, 0);
     }
   }
 
@@ -132,53 +132,69 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   r.seeds.setZero(n, k);
   for (int a = 0; a < nf; ++a) {
     r.seeds.row(f_[a]).head(nu) = r.B.row(a);
-    if (m > 0) r.seeds(f_[a], nu) = beta[a];
+    if (m > 0) r.seeds(f_[a], nu) = w.beta[a];
   }
-  // (M's composite-inertia entries, NAME_mass_matrix, applied to [B beta] entry by entry cost the
-  // sedan as much as the tangent's 14 extra directions: udd 322 k instructions against 304 k,
+  // (M's composite-inertia entries, NAME_mass_matrix, applied to [B beta] entry by entry cost
+  // the sedan more than the tangent's 14 extra directions: udd 11 to 18 k instructions more,
   // docs/performance.md; the tangent is kept.)
-  std::vector<double> out(n);
+  w.out.resize(n);
   r.MB.resize(n, k);
-  model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, k, r.seeds.data(), out.data(), r.MB.data());
+  model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, k, r.seeds.data(), w.out.data(), r.MB.data());
 
   // a tree (no constraints, u in coordinate order): B = I, M B = M, and the products would cost
   // two dense n^3 products
   const bool identity = m == 0 && u_ == f_;
   const bool whole = identity && nf == n;  // no driven joints either: M_ff B is M
-  Vector Mbeta = Vector::Zero(nf);
-  Vector cf(nf);
+  w.Mbeta.setZero(nf);
+  w.cf.resize(nf);
   if (!whole) r.MBf.resize(nf, nu);  // M_ff B
   for (int a = 0; a < nf; ++a) {
     if (!whole) r.MBf.row(a) = r.MB.row(f_[a]).head(nu);
-    if (m > 0) Mbeta[a] = r.MB(f_[a], nu);
-    cf[a] = c[f_[a]];
+    if (m > 0) w.Mbeta[a] = r.MB(f_[a], nu);
+    w.cf[a] = c[f_[a]];
   }
-  if (whole) r.reduced.compute(r.MB);
-  else if (identity) r.reduced.compute(r.MBf);
-  else r.reduced.compute(r.B.transpose() * r.MBf);
+  if (whole) {
+    r.reduced.compute(r.MB);
+  } else if (identity) {
+    r.reduced.compute(r.MBf);
+  } else {
+    w.reduced.resize(nu, nu);
+    w.reduced.noalias() = r.B.transpose() * r.MBf;
+    r.reduced.compute(w.reduced);
+  }
   if (r.reduced.info() != Eigen::Success)
     throw std::runtime_error(std::string(model_.name) + ": reduced mass matrix is not positive definite");
-  r.udd = identity ? Vector(r.reduced.solve(-cf)) : Vector(r.reduced.solve(-(r.B.transpose() * (cf + Mbeta))));
-  const Vector qddf = r.B * r.udd + beta;
-  for (int a = 0; a < nf; ++a) r.qdd[f_[a]] = qddf[a];
+  w.cf += w.Mbeta;
+  if (identity) {
+    r.udd = w.cf;
+  } else {
+    r.udd.resize(nu);
+    r.udd.noalias() = r.B.transpose() * w.cf;
+  }
+  r.reduced.solveInPlace(r.udd);
+  r.udd = -r.udd;
+  w.qddf = w.beta;
+  w.qddf.noalias() += r.B * r.udd;
+  for (int a = 0; a < nf; ++a) r.qdd[f_[a]] = w.qddf[a];
 
   // Multipliers: J^T lam = M qdd + c on the dependent rows, M qdd = M B udd + M beta.
-  r.lam = Vector::Zero(m);
+  r.lam.setZero(m);
   if (m > 0) {
-    const Vector full = c + r.MB.leftCols(nu) * r.udd + r.MB.col(nu);
-    Vector fv(m);
-    for (int i = 0; i < m; ++i) fv[i] = full[v_[i]];
-    r.lam = r.Jv.transpose_solve(fv);
+    w.full = c + r.MB.col(nu);
+    w.full.noalias() += r.MB.leftCols(nu) * r.udd;
+    w.fv.resize(m);
+    for (int i = 0; i < m; ++i) w.fv[i] = w.full[v_[i]];
+    r.Jv.transpose_solve(w.fv.data(), m, 1, r.lam.data(), m);
   }
 }
 
 void ReducedDynamics::seed_arrays(int nd, const double* dinputs, const double* dp_in, Matrix& dinp, Matrix& dp,
                                   Matrix& dqdd) const {
-  dinp = Matrix::Zero(std::max(1, model_.inputs), nd);
-  dp = Matrix::Zero(std::max(1, model_.parameters), nd);
+  dinp.setZero(std::max(1, model_.inputs), nd);
+  dp.setZero(std::max(1, model_.parameters), nd);
   if (dinputs && model_.inputs) dinp = Eigen::Map<const Matrix>(dinputs, model_.inputs, nd);
   if (dp_in && model_.parameters) dp = Eigen::Map<const Matrix>(dp_in, model_.parameters, nd);
-  dqdd = Matrix::Zero(model_.n, nd);
+  dqdd.setZero(model_.n, nd);
   for (int d = 0; d < nd; ++d)
     for (std::size_t i = 0; i < d_.size(); ++i) dqdd(d_[i], d) = dinp(model_.load_inputs + 3 * i + 2, d);
 }
@@ -189,10 +205,10 @@ void ReducedDynamics::tangent_kinematics(const Result& r, const double* inputs, 
   const int n = model_.n, m = model_.m, nu = this->nu();
   const double* p = params(p_in);
   const double* in = model_.inputs ? inputs : pad_.data();
-  Matrix dinp, dp, dqdd;
-  seed_arrays(nd, dinputs, dp_in, dinp, dp, dqdd);
-  dq = Matrix::Zero(n, nd);
-  dqd = Matrix::Zero(n, nd);
+  Result::Work& w = r.work;
+  seed_arrays(nd, dinputs, dp_in, w.dinp, w.dp, w.dqdd_seed);
+  dq.setZero(n, nd);
+  dqd.setZero(n, nd);
   const int driven_at = model_.load_inputs;
   for (int d = 0; d < nd; ++d) {
     for (int i = 0; i < nu; ++i) {
@@ -200,23 +216,26 @@ void ReducedDynamics::tangent_kinematics(const Result& r, const double* inputs, 
       dqd(u_[i], d) = dud ? dud[d * nu + i] : 0.0;
     }
     for (std::size_t i = 0; i < d_.size(); ++i) {
-      dq(d_[i], d) = dinp(driven_at + 3 * i, d);
-      dqd(d_[i], d) = dinp(driven_at + 3 * i + 1, d);
+      dq(d_[i], d) = w.dinp(driven_at + 3 * i, d);
+      dqd(d_[i], d) = w.dinp(driven_at + 3 * i + 1, d);
     }
   }
-  const Vector lam = r.lam.size() >= std::max(m, 1) ? r.lam : Vector::Zero(std::max(m, 1));  // not read here
   if (m > 0) {
     // dh = Ju du + Jv dv + h_p dp = 0 (h's own tangent), then d(J qd) = 0 likewise for dv_dot.
-    std::vector<double> out(2 * m);
-    Matrix dout(2 * m, nd), dh(m, nd);
-    model_.constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), in, p, nd, dq.data(), dqd.data(),
-                               dqdd.data(), dinp.data(), dp.data(), out.data(), dh.data());
-    const Matrix dv = -r.Jv.solve(dh);
-    for (int i = 0; i < m; ++i) dq.row(v_[i]) = dv.row(i);
-    model_.velocity_constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), in, p, nd, dq.data(),
-                                        dqd.data(), dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
-    const Matrix dvd = -r.Jv.solve(Matrix(dout.bottomRows(m)));
-    for (int i = 0; i < m; ++i) dqd.row(v_[i]) = dvd.row(i);
+    // (lam is not read by these functions.)
+    w.out.resize(2 * m);
+    w.dout.resize(2 * m, nd);
+    w.dh.resize(m, nd);
+    w.dv.resize(m, nd);
+    model_.constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, nd, dq.data(),
+                               dqd.data(), w.dqdd_seed.data(), w.dinp.data(), w.dp.data(), w.out.data(), w.dh.data());
+    r.Jv.solve(w.dh.data(), m, nd, w.dv.data(), m);
+    for (int i = 0; i < m; ++i) dq.row(v_[i]) = -w.dv.row(i);
+    model_.velocity_constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, nd,
+                                        dq.data(), dqd.data(), w.dqdd_seed.data(), w.dinp.data(), w.dp.data(),
+                                        w.out.data(), w.dout.data());
+    r.Jv.solve(w.dout.data() + m, 2 * m, nd, w.dv.data(), m);
+    for (int i = 0; i < m; ++i) dqd.row(v_[i]) = -w.dv.row(i);
   }
 }
 
@@ -233,34 +252,40 @@ void ReducedDynamics::tangent_dynamics(const Result& r, const double* inputs, co
   const int n = model_.n, m = model_.m;
   const double* p = params(p_in);
   const double* in = model_.inputs ? inputs : pad_.data();
-  Matrix dinp, dp;
-  seed_arrays(nd, dinputs, dp_in, dinp, dp, dqdd);
-  const Vector lam = m ? r.lam : Vector::Zero(1);
+  Result::Work& w = r.work;
+  seed_arrays(nd, dinputs, dp_in, w.dinp, w.dp, dqdd);
+  const double* lam = m ? r.lam.data() : pad_.data();
   // dr = dM qdd + dc - dJ^T lam (qdd, lam frozen; driven dqdd seeded), da = dJ qdd + d(Jdot qd).
-  std::vector<double> out(n + m);
-  Matrix dout(n + m, nd);
-  model_.residual_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), in, p, nd, dq.data(), dqd.data(),
-                          dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
+  w.out.resize(n + m);
+  w.dout.resize(n + m, nd);
+  model_.residual_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam, in, p, nd, dq.data(), dqd.data(),
+                          dqdd.data(), w.dinp.data(), w.dp.data(), w.out.data(), w.dout.data());
   const int nf = static_cast<int>(f_.size());
-  Matrix dbeta = Matrix::Zero(nf, nd), drf(nf, nd);
+  w.dbeta.setZero(nf, nd);
+  w.drf.resize(nf, nd);
   if (m > 0) {
-    const Matrix dbeta_v = -r.Jv.solve(Matrix(dout.bottomRows(m)));
-    for (int a = 0; a < nf; ++a) {
-      const auto iv = std::find(v_.begin(), v_.end(), f_[a]);
-      if (iv != v_.end()) dbeta.row(a) = dbeta_v.row(iv - v_.begin());
-    }
+    w.dbeta_v.resize(m, nd);
+    r.Jv.solve(w.dout.data() + n, n + m, nd, w.dbeta_v.data(), m);
+    for (int a = 0; a < nf; ++a)
+      if (free_place_[a] < 0) w.dbeta.row(a) = -w.dbeta_v.row(-1 - free_place_[a]);
   }
-  for (int a = 0; a < nf; ++a) drf.row(a) = dout.row(f_[a]);
+  for (int a = 0; a < nf; ++a) w.drf.row(a) = w.dout.row(f_[a]);
   // a tree in coordinate order: B = I (see solve_dynamics); otherwise B^T M_ff dbeta =
   // (M_ff B)^T dbeta, M being symmetric, with M_ff B from solve_dynamics
   if (m == 0 && u_ == f_) {
-    const Matrix dudd = r.reduced.solve(-drf);
-    for (int a = 0; a < nf; ++a) dqdd.row(f_[a]) = dudd.row(a);
+    w.dudd = w.drf;
+    r.reduced.solveInPlace(w.dudd);
+    for (int a = 0; a < nf; ++a) dqdd.row(f_[a]) = -w.dudd.row(a);
     return;
   }
-  const Matrix dudd = r.reduced.solve(-(r.B.transpose() * drf + r.MBf.transpose() * dbeta));
-  const Matrix dqddf = r.B * dudd + dbeta;
-  for (int a = 0; a < nf; ++a) dqdd.row(f_[a]) = dqddf.row(a);
+  w.dudd.resize(nu(), nd);
+  w.dudd.noalias() = r.B.transpose() * w.drf;
+  w.dudd.noalias() += r.MBf.transpose() * w.dbeta;
+  r.reduced.solveInPlace(w.dudd);
+  w.dudd = -w.dudd;
+  w.drf = w.dbeta;  // dqdd on the free coordinates
+  w.drf.noalias() += r.B * w.dudd;
+  for (int a = 0; a < nf; ++a) dqdd.row(f_[a]) = w.drf.row(a);
 }
 
 }  // namespace dydp::mbs

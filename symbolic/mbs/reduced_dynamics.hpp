@@ -31,8 +31,17 @@ class ReducedDynamics {
     BlockLU Jv;                                   // dependent columns of J, loop by loop
     Matrix B;                                     // free coordinates x nu
     Eigen::LLT<Matrix> reduced;                   // B^T M_ff B
-    Matrix seeds, MBf;                            // work space: [B beta] over q, M_ff B
+    Matrix seeds, MBf;                            // [B beta] over q, M_ff B
     int newton_iterations = 0;
+    // Scratch storage sized at the first call and reused, so that a solve and its tangents
+    // allocate nothing once the sizes are known (the right-hand side's path).
+    struct Work {
+      std::vector<double> hj, res, out, lam_zero;
+      Vector beta, cf, Mbeta, full, fv, qddf;
+      Matrix Ju, Bv, beta_v, reduced;
+      Matrix dinp, dp, dqdd_seed, dout, dh, dv, dbeta_v, dbeta, drf, dudd;
+    };
+    mutable Work work;
   };
 
   // u, u_dot (nu), inputs, parameters (model sizes; p may be null for the model's values).
@@ -70,6 +79,8 @@ class ReducedDynamics {
   // driven joints' accelerations.
   void seed_arrays(int nd, const double* dinputs, const double* dp, Matrix& dinp, Matrix& dp_out,
                    Matrix& dqdd) const;
+  // Row a of the free coordinates: its place among u (>= 0), or -1 - its place among v.
+  std::vector<int> free_place_;
   const GeneratedModel& model_;
   std::vector<int> u_, v_, f_, d_;
   std::vector<double> pad_;  // one zero for arrays of size zero

@@ -45,6 +45,43 @@ TEST(BlockLU, SolvesPermutedBlockMatricesLikeADenseLU) {
   EXPECT_LT((lu.transpose_solve(b) - dense_transposed).cwiseAbs().maxCoeff(), 1e-12);
 }
 
+TEST(BlockLU, PivotsOnZeroDiagonalsAndSolvesInPlace) {
+  // two blocks whose leading entries are zero: elimination without row exchanges would divide
+  // by zero; solved in place (x given as b), as the partitioning does
+  Matrix A = Matrix::Zero(5, 5);
+  A.block(0, 0, 3, 3) << 0.0, 2.0, 1.0,  //
+      4.0, 0.0, -1.0,                    //
+      1.0, 1e-3, 0.0;
+  A.block(3, 3, 2, 2) << 0.0, 3.0,  //
+      -2.0, 0.5;
+  BlockLU lu;
+  lu.set_pattern(A.unaryExpr([](double x) { return x != 0.0; }).cast<char>());
+  ASSERT_EQ(lu.blocks(), 2);
+  ASSERT_TRUE(lu.compute(A));
+  const Eigen::PartialPivLU<Matrix> dense(A);
+  Matrix b(5, 2);
+  b << 1.0, -2.0, 0.5, 3.0, -1.0, 0.25, 2.0, 1.0, -0.5, 4.0;
+  Matrix x = b;
+  lu.solve(x.data(), 5, 2, x.data(), 5);
+  EXPECT_LT((x - dense.solve(b)).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((A * x - b).cwiseAbs().maxCoeff(), 1e-12);
+  Matrix y = b;
+  lu.transpose_solve(y.data(), 5, 2, y.data(), 5);
+  EXPECT_LT((A.transpose() * y - b).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+TEST(BlockLU, ReportsASingularBlock) {
+  Matrix A = Matrix::Identity(4, 4);
+  A(2, 3) = A(3, 2) = 1.0;
+  A(2, 2) = A(3, 3) = 1.0;  // the block {2, 3} is [[1, 1], [1, 1]]
+  BlockLU lu;
+  lu.set_pattern(A.unaryExpr([](double x) { return x != 0.0; }).cast<char>());
+  EXPECT_EQ(lu.blocks(), 3);
+  EXPECT_FALSE(lu.compute(A));
+  A(3, 3) = 2.0;
+  EXPECT_TRUE(lu.compute(A));
+}
+
 TEST(BlockLU, NonSquareComponentsFallBackToOneBlock) {
   Pattern p = Pattern::Zero(3, 3);
   p(0, 0) = p(1, 0) = p(2, 1) = p(2, 2) = 1;  // rows {0, 1} read column 0 only
