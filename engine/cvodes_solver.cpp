@@ -2,8 +2,12 @@
 // right-hand side is the diagram's tangent pass, corrected simultaneously with the states and
 // included in the error test or not (solver.sens_error_test); absolute tolerances per state
 // from the blocks' nominal magnitudes (engine/tolerances.hpp); the Newton matrix is the exact
-// Jacobian from tangent passes over the states; objective integrals are quadratures with their
-// own sensitivities. Steps are taken one at a time to count the states that limit them.
+// Jacobian from tangent passes over the states. Objective integrals are integrated with the
+// states: CVODES' vector is [x; q], their integrands evaluated by the same value and tangent
+// passes as xdot (CVODES' own quadratures would cost one more value pass and one more tangent
+// pass per step, at the corrected solution), held to their own tolerances and, with the
+// sensitivities, their sensitivities' (in the error test with the states' sensitivities). Steps
+// are taken one at a time to count the states that limit them.
 #include "engine/cvodes_solver.hpp"
 
 #include <cvodes/cvodes.h>
@@ -29,10 +33,13 @@ namespace {
 /// What the C callbacks need, and what they found when they had to refuse a point.
 struct Problem {
   Problem(const Diagram& diagram, Evaluator& evaluator, int states, int directions)
-      : d(diagram), ev(evaluator), nx(states), ns(directions) {}
+      : d(diagram), ev(evaluator), nx(states), nq(diagram.num_quadratures), ny(std::max(states + nq, 1)),
+        ns(directions) {}
   const Diagram& d;
   Evaluator& ev;
-  int nx;                 ///< states of the diagram (CVODES gets max(nx, 1))
+  int nx;                 ///< states of the diagram
+  int nq;                 ///< objective integrals, after the states in CVODES' vector
+  int ny;                 ///< CVODES' vector: max(nx + nq, 1)
   int ns;
   std::vector<double> dx, dxdot, identity;
   std::string refusal;    ///< last block that refused a point: "block: reason"
@@ -78,8 +85,12 @@ int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
   auto& P = *static_cast<Problem*>(user);
   double* xdot = NV_DATA_S(ydot);
   if (!P.scene_values.empty()) P.ev.use_parameter_values(P.scene_values.data());
-  if (P.nx == 0) xdot[0] = 0.0;
-  if (const int flag = guarded(P, t, [&] { P.ev.derivatives(t, NV_DATA_S(y), xdot); })) return flag;
+  if (P.nx + P.nq == 0) xdot[0] = 0.0;
+  if (const int flag = guarded(P, t, [&] {
+        P.ev.derivatives(t, NV_DATA_S(y), xdot);
+        if (P.nq > 0) P.ev.quadratures(t, NV_DATA_S(y), xdot + P.nx);  // the same value pass
+      }))
+    return flag;
   if (!P.ev.all_finite(xdot)) {
     P.refuse(t, P.ev.find_nonfinite(xdot));
     return 1;  // recoverable: CVODES retries with a smaller step, then fails naming it
@@ -91,52 +102,28 @@ int sens_rhs(int ns, sunrealtype t, N_Vector y, N_Vector, N_Vector* yS, N_Vector
              void* user, N_Vector, N_Vector) {
   auto& P = *static_cast<Problem*>(user);
   return guarded(P, t, [&] {
-    gather(yS, P.nx, ns, P.dx);
-    P.dxdot.assign(static_cast<size_t>(P.nx) * ns, 0.0);
-    P.ev.tangents(t, NV_DATA_S(y), ns, {P.dx.data(), P.nx}, true, {P.dxdot.data(), P.nx}, {});
-    if (P.nx > 0) scatter(P.dxdot, P.nx, ns, ySdot);
+    gather(yS, P.nx, ns, P.dx);  // the states' part: nothing reads the integrals
+    P.dxdot.assign(static_cast<size_t>(P.ny) * ns, 0.0);
+    P.ev.tangents(t, NV_DATA_S(y), ns, {P.dx.data(), P.nx}, true, {P.dxdot.data(), P.ny},
+                  {P.dxdot.data() + P.nx, P.ny});
+    scatter(P.dxdot, P.ny, ns, ySdot);
     ++P.sens_passes;
   });
 }
 
+// The Newton matrix's columns for the states from one tangent pass seeded on each; the
+// integrals' rows come with it, and their columns are zero (nothing reads an integral).
 int jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix J, void* user, N_Vector, N_Vector,
              N_Vector) {
   auto& P = *static_cast<Problem*>(user);
   SUNMatZero(J);
   if (P.nx == 0) return 0;
   return guarded(P, t, [&] {
-    P.ev.tangents(t, NV_DATA_S(y), P.nx, {P.identity.data(), P.nx}, false,
-                  {SM_DATA_D(J), static_cast<int>(SM_ROWS_D(J))}, {});
+    const int ld = static_cast<int>(SM_ROWS_D(J));
+    P.ev.tangents(t, NV_DATA_S(y), P.nx, {P.identity.data(), P.nx}, false, {SM_DATA_D(J), ld},
+                  {SM_DATA_D(J) + P.nx, ld});
     ++P.jac_passes;
   });
-}
-
-int quad_rhs(sunrealtype t, N_Vector y, N_Vector qdot, void* user) {
-  auto& P = *static_cast<Problem*>(user);
-  if (!P.scene_values.empty()) P.ev.use_parameter_values(P.scene_values.data());
-  try {
-    P.ev.quadratures(t, NV_DATA_S(y), NV_DATA_S(qdot));
-  } catch (const OutOfDomain& e) {
-    P.refuse(t, e.reason);
-    return 1;
-  }
-  return 0;
-}
-
-int quad_sens_rhs(int ns, sunrealtype t, N_Vector y, N_Vector* yS, N_Vector, N_Vector* yQSdot,
-                  void* user, N_Vector, N_Vector) {
-  auto& P = *static_cast<Problem*>(user);
-  const int nq = P.d.num_quadratures;
-  try {
-    gather(yS, P.nx, ns, P.dx);
-    std::vector<double> dq(static_cast<size_t>(nq) * ns, 0.0);
-    P.ev.tangents(t, NV_DATA_S(y), ns, {P.dx.data(), P.nx}, true, {}, {dq.data(), nq});
-    scatter(dq, nq, ns, yQSdot);
-  } catch (const OutOfDomain& e) {
-    P.refuse(t, e.reason);
-    return 1;
-  }
-  return 0;
 }
 
 void error_handler(int, const char* module, const char* function, char* msg, void* user) {
@@ -147,9 +134,8 @@ void error_handler(int, const char* module, const char* function, char* msg, voi
 struct Sundials {
   SUNContext ctx = nullptr;
   void* mem = nullptr;
-  N_Vector y = nullptr, yq = nullptr;
+  N_Vector y = nullptr;
   N_Vector* ys = nullptr;
-  N_Vector* yqs = nullptr;
   int ns = 0;
   SUNMatrix A = nullptr;
   SUNLinearSolver LS = nullptr;
@@ -158,9 +144,7 @@ struct Sundials {
   ~Sundials() {
     if (mem) CVodeFree(&mem);
     if (ys) N_VDestroyVectorArray(ys, ns);
-    if (yqs) N_VDestroyVectorArray(yqs, ns);
     if (y) N_VDestroy(y);
-    if (yq) N_VDestroy(yq);
     if (LS) SUNLinSolFree(LS);
     if (A) SUNMatDestroy(A);
     if (NLS) SUNNonlinSolFree(NLS);
@@ -175,7 +159,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   const bool bdf = d.solver.method == "bdf";
   const int nx = d.num_states, nq = d.num_quadratures;
   const int ns = options.sensitivities ? static_cast<int>(d.sensitivities.size()) : 0;
-  const int n_cv = std::max(nx, 1);
+  const int n_cv = std::max(nx + nq, 1);  // [x; q]
   const double t0 = d.time.start, tf = d.time.stop;
 
   Evaluator ev(d, ns > 0);
@@ -211,6 +195,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   N_Vector atol_states = N_VClone(S.y);
   N_VConst(d.solver.atol, atol_states);
   std::copy_n(atols.states.data(), nx, NV_DATA_S(atol_states));
+  std::copy_n(atols.quadratures.data(), nq, NV_DATA_S(atol_states) + nx);
   const int sv_flag = CVodeSVtolerances(S.mem, d.solver.rtol, atol_states);
   N_VDestroy(atol_states);
   check(sv_flag, "CVodeSVtolerances");
@@ -248,6 +233,8 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
     for (int dir = 0; dir < ns; ++dir) {
       N_VConst(d.solver.atol, atol_sens[dir]);  // the placeholder state of a stateless diagram
       std::copy_n(atols.sensitivities.data() + static_cast<size_t>(dir) * nx, nx, NV_DATA_S(atol_sens[dir]));
+      std::copy_n(atols.quadrature_sensitivities.data() + static_cast<size_t>(dir) * nq, nq,
+                  NV_DATA_S(atol_sens[dir]) + nx);
     }
     const int ssv_flag = CVodeSensSVtolerances(S.mem, d.solver.rtol, atol_sens);
     N_VDestroyVectorArray(atol_sens, ns);
@@ -258,34 +245,6 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
       check(CVodeSetNonlinearSolverSensSim(S.mem, S.NLSsens), "CVodeSetNonlinearSolverSensSim");
     }
   }
-  if (nq > 0) {
-    S.yq = N_VNew_Serial(nq, S.ctx);
-    N_VConst(0.0, S.yq);
-    check(CVodeQuadInit(S.mem, quad_rhs, S.yq), "CVodeQuadInit");
-    N_Vector atol_quad = N_VClone(S.yq);
-    std::copy_n(atols.quadratures.data(), nq, NV_DATA_S(atol_quad));
-    const int qsv_flag = CVodeQuadSVtolerances(S.mem, d.solver.rtol, atol_quad);
-    N_VDestroy(atol_quad);
-    check(qsv_flag, "CVodeQuadSVtolerances");
-    check(CVodeSetQuadErrCon(S.mem, SUNTRUE), "CVodeSetQuadErrCon");
-    if (ns > 0) {
-      S.yqs = N_VCloneVectorArray(ns, S.yq);
-      for (int dir = 0; dir < ns; ++dir) N_VConst(0.0, S.yqs[dir]);
-      // Quadrature sensitivities always come from the exact integrand tangents (also in
-      // difference-quotient mode: CVODES 6.4's internal quadrature quotients crashed here).
-      check(CVodeQuadSensInit(S.mem, quad_sens_rhs, S.yqs),
-            "CVodeQuadSensInit");
-      N_Vector* atol_quad_sens = N_VCloneVectorArray(ns, S.yq);
-      for (int dir = 0; dir < ns; ++dir)
-        std::copy_n(atols.quadrature_sensitivities.data() + static_cast<size_t>(dir) * nq, nq,
-                    NV_DATA_S(atol_quad_sens[dir]));
-      const int qssv_flag = CVodeQuadSensSVtolerances(S.mem, d.solver.rtol, atol_quad_sens);
-      N_VDestroyVectorArray(atol_quad_sens, ns);
-      check(qssv_flag, "CVodeQuadSensSVtolerances");
-      check(CVodeSetQuadSensErrCon(S.mem, d.solver.sens_error_test), "CVodeSetQuadSensErrCon");
-    }
-  }
-
   RunStats& st = result.stats;
   auto accumulate = [&] {
     long v = 0;
@@ -386,17 +345,9 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
       // The solution at the breakpoint (the last step ended there: it is the stop time) first,
       // then the restart from it.
       if (ns > 0) check(CVodeGetSensDky(S.mem, target, 0, S.ys), "CVodeGetSensDky");
-      if (nq > 0) {
-        check(CVodeGetQuadDky(S.mem, target, 0, S.yq), "CVodeGetQuadDky");
-        if (ns > 0) check(CVodeGetQuadSensDky(S.mem, target, 0, S.yqs), "CVodeGetQuadSensDky");
-      }
       check(CVodeReInit(S.mem, target, S.y), "CVodeReInit");
       reached = target;
       if (ns > 0) check(CVodeSensReInit(S.mem, CV_SIMULTANEOUS, S.ys), "CVodeSensReInit");
-      if (nq > 0) {
-        check(CVodeQuadReInit(S.mem, S.yq), "CVodeQuadReInit");
-        if (ns > 0) check(CVodeQuadSensReInit(S.mem, S.yqs), "CVodeQuadSensReInit");
-      }
       t = target;
     }
   }
@@ -404,14 +355,12 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   st.sens_rhs_evals = P.sens_passes;
   st.limiting_states = limiters.ranking(d);
 
+  // the integrals at the end: S.y and S.ys hold the solution at tf (the last output)
   std::vector<double> q(std::max(nq, 1), 0.0), dq(static_cast<size_t>(std::max(nq, 1)) * ns, 0.0);
-  if (nq > 0) {
-    check(CVodeGetQuad(S.mem, &t, S.yq), "CVodeGetQuad");
-    std::copy_n(NV_DATA_S(S.yq), nq, q.data());
-    if (ns > 0) {
-      check(CVodeGetQuadSens(S.mem, &t, S.yqs), "CVodeGetQuadSens");
-      gather(S.yqs, nq, ns, dq);
-    }
+  std::copy_n(NV_DATA_S(S.y) + nx, nq, q.data());
+  if (ns > 0 && nq > 0) {
+    check(CVodeGetSensDky(S.mem, t, 0, S.ys), "CVodeGetSensDky");
+    for (int dir = 0; dir < ns; ++dir) std::copy_n(NV_DATA_S(S.ys[dir]) + nx, nq, dq.data() + dir * nq);
   }
   recorder.finish(q.data(), {dq.data(), std::max(nq, 1)});
   result.final_state.assign(NV_DATA_S(S.y), NV_DATA_S(S.y) + nx);
