@@ -40,7 +40,10 @@ class Multibody : public Block {
   // `exposed`: block parameters are [model parameters, q0 of u, qd0 of u]; otherwise none.
   Multibody(const GeneratedModel& model, bool exposed)
       : g_(model), reduced_(model), exposed_(exposed), last_q_(Eigen::Map<const Vector>(model.initial_q, model.n)) {
-    for (int i = 0; i < g_.loads; ++i) declare_input(g_.load_names[i], g_.load_widths[i], "N or N m");
+    for (int i = 0, at = 0; i < g_.loads; at += g_.load_widths[i], ++i) {
+      declare_input(g_.load_names[i], g_.load_widths[i], "N or N m");
+      load_offsets_.push_back(at);
+    }
     for (int i = 0; i < g_.driven_count; ++i) {
       // scalar ports, so that a steering source wires directly: NAME (q), NAME_rate, NAME_acc
       const std::string joint = g_.coordinate_names[g_.driven[i]];
@@ -188,11 +191,7 @@ class Multibody : public Block {
       }
     return in;
   }
-  int load_offset(int k) const {
-    int at = 0;
-    for (int i = 0; i < k; ++i) at += g_.load_widths[i];
-    return at;
-  }
+  int load_offset(int k) const { return load_offsets_[k]; }
 
   // Whether this output call sets an output that reads accelerations (qdd, acceleration
   // sensors); the call for positions and velocities comes first, before the loads are known.
@@ -319,6 +318,7 @@ class Multibody : public Block {
   };
 
   const GeneratedModel& g_;
+  std::vector<int> load_offsets_;  ///< each load's first entry in the model's input array
   ReducedDynamics reduced_;
   bool exposed_;
   const double zero_[1] = {0.0};

@@ -82,6 +82,7 @@ void ReducedDynamics::solve_kinematics(const double* u, const double* ud, const 
       r.Jv.solve(w.hj.data(), m, 1, w.fv.data(), m);
       for (int i = 0; i < m; ++i) r.q[v_[i]] -= w.fv[i];
     }
+    r.Jv.invert();  // the factors at the solution serve many right-hand sides from here on
     w.fv.noalias() = r.J * r.qd;  // Jv vd = -J qd (vd still zero in qd)
     r.Jv.solve(w.fv.data(), m, 1, w.fv.data(), m);
     for (int i = 0; i < m; ++i) r.qd[v_[i]] = -w.fv[i];
