@@ -143,7 +143,12 @@ void BlockLU::solve(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs, doub
       const int* __restrict from = b.rows.data();
       const int* __restrict to = b.cols.data();
       double* __restrict z = t + size_;
-      for (int j = 0; j < k; ++j) z[j] = t[from[j]];
+      bool zero = true;
+      for (int j = 0; j < k; ++j) zero = (z[j] = t[from[j]]) == 0.0 && zero;
+      if (zero) {  // a right-hand side that does not reach this block (another loop's column)
+        for (int i = 0; i < k; ++i) xc[to[i]] = 0.0;
+        continue;
+      }
       for (int i = 0; i < k; ++i) {
         double sum = 0.0;
         for (int j = 0; j < k; ++j) sum += inv[i * k + j] * z[j];

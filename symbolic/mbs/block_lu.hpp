@@ -35,6 +35,9 @@ class BlockLU {
   Matrix solve(const Matrix& b) const;
   Matrix transpose_solve(const Matrix& b) const;
   int blocks() const { return static_cast<int>(blocks_.size()); }
+  // The rows and the columns of block b (indices into the pattern).
+  const std::vector<int>& block_rows(int b) const { return blocks_[b].rows; }
+  const std::vector<int>& block_cols(int b) const { return blocks_[b].cols; }
   int size() const { return size_; }
 
  private:

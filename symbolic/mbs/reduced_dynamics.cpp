@@ -30,6 +30,33 @@ ReducedDynamics::ReducedDynamics(const GeneratedModel& model) : model_(model), p
     free_place_.push_back(iu != u_.end() ? static_cast<int>(iu - u_.begin())
                                          : -1 - static_cast<int>(std::find(v_.begin(), v_.end(), j) - v_.begin()));
   }
+  // B's structure from J's and Jv's blocks
+  const int nu = this->nu(), n = model.n;
+  std::vector<std::vector<int>> block_u(jv_blocks_.blocks());
+  std::vector<int> block_of_v(model.m, 0);
+  for (int b = 0; b < jv_blocks_.blocks(); ++b) {
+    for (int k : jv_blocks_.block_cols(b)) block_of_v[k] = b;
+    for (int i = 0; i < nu; ++i) {
+      bool reads = false;
+      for (int row : jv_blocks_.block_rows(b)) reads = reads || model.jacobian_nonzero[row * n + u_[i]] != 0;
+      if (reads) block_u[b].push_back(i);
+    }
+  }
+  b_cols_.resize(f_.size());
+  free_row_of_.assign(n, -1);
+  for (std::size_t a = 0; a < f_.size(); ++a) {
+    free_row_of_[f_[a]] = static_cast<int>(a);
+    b_cols_[a] = free_place_[a] >= 0 ? std::vector<int>{free_place_[a]} : block_u[block_of_v[-1 - free_place_[a]]];
+  }
+  s_start_.assign(1, 0);
+  for (int j = 0; j < n; ++j) {
+    const int a = free_row_of_[j];
+    if (a >= 0) {
+      s_col_.insert(s_col_.end(), b_cols_[a].begin(), b_cols_[a].end());
+      if (free_place_[a] < 0) s_col_.push_back(nu);  // beta
+    }
+    s_start_.push_back(static_cast<int>(s_col_.size()));
+  }
 }
 
 void ReducedDynamics::solve(const double* u, const double* ud, const double* inputs, const double* p,
@@ -126,25 +153,46 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
     }
   }
 
-  // M [B beta] from the inertial pass seeded on those accelerations (nu + 1 directions; M
-  // itself, n directions, is never formed): M qdd for qdd = B udd + beta is all we need.
-  const int k = nu + (m > 0 ? 1 : 0);
-  // kept in r between calls: a large tree's n x n blocks would be fresh pages at every call
-  r.seeds.setZero(n, k);
-  for (int a = 0; a < nf; ++a) {
-    r.seeds.row(f_[a]).head(nu) = r.B.row(a);
-    if (m > 0) r.seeds(f_[a], nu) = w.beta[a];
-  }
-  // (M's composite-inertia entries, NAME_mass_matrix, applied to [B beta] entry by entry cost
-  // the sedan more than the tangent's 14 extra directions: udd 11 to 18 k instructions more,
-  // docs/performance.md; the tangent is kept.)
-  w.out.resize(n);
-  r.MB.resize(n, k);
-  model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, k, r.seeds.data(), w.out.data(), r.MB.data());
-
   // a tree (no constraints, u in coordinate order): B = I, M B = M, and the products would cost
   // two dense n^3 products
   const bool identity = m == 0 && u_ == f_;
+  // M [B beta]: M qdd for qdd = B udd + beta is all we need.
+  const int k = nu + (m > 0 ? 1 : 0);
+  r.MB.resize(n, k);
+  if (model_.mass_matrix && !identity) {
+    // M's structurally nonzero entries by composite inertias times the structurally nonzero
+    // entries of [B beta]: a corner's rows meet a corner's two or three columns
+    w.mass.resize(std::max(1, model_.mass_entries));
+    model_.mass_matrix(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, w.mass.data());
+    w.s_val.resize(s_col_.size());
+    for (int j = 0; j < n; ++j) {
+      const int a = free_row_of_[j];
+      for (int t = s_start_[j]; t < s_start_[j + 1]; ++t) w.s_val[t] = s_col_[t] < nu ? r.B(a, s_col_[t]) : w.beta[a];
+    }
+    r.MB.setZero();
+    double* mb = r.MB.data();
+    const int* start = s_start_.data();
+    const int* col = s_col_.data();
+    const double* val = w.s_val.data();
+    for (int e = 0; e < model_.mass_entries; ++e) {
+      const int i = model_.mass_rows[e], j = model_.mass_cols[e];
+      const double v = w.mass[e];
+      for (int t = start[j]; t < start[j + 1]; ++t) mb[col[t] * n + i] += v * val[t];
+      if (i != j)
+        for (int t = start[i]; t < start[i + 1]; ++t) mb[col[t] * n + j] += v * val[t];
+    }
+  } else {
+    // the inertial pass seeded on [B beta] (nu + 1 directions; M itself, n directions, is never
+    // formed); a tree too deep for M's entries, or one whose B is the identity
+    r.seeds.setZero(n, k);  // kept in r: a large tree's n x n blocks would be fresh pages each call
+    for (int a = 0; a < nf; ++a) {
+      r.seeds.row(f_[a]).head(nu) = r.B.row(a);
+      if (m > 0) r.seeds(f_[a], nu) = w.beta[a];
+    }
+    w.out.resize(n);
+    model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, k, r.seeds.data(), w.out.data(), r.MB.data());
+  }
+
   const bool whole = identity && nf == n;  // no driven joints either: M_ff B is M
   w.Mbeta.setZero(nf);
   w.cf.resize(nf);
@@ -159,8 +207,9 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   } else if (identity) {
     r.reduced.compute(r.MBf);
   } else {
-    w.reduced.resize(nu, nu);
-    w.reduced.noalias() = r.B.transpose() * r.MBf;
+    w.reduced.setZero(nu, nu);  // B^T M_ff B over B's structure
+    for (int a = 0; a < nf; ++a)
+      for (int c : b_cols_[a]) w.reduced.row(c) += r.B(a, c) * r.MBf.row(a);
     r.reduced.compute(w.reduced);
   }
   if (r.reduced.info() != Eigen::Success)
@@ -169,13 +218,15 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   if (identity) {
     r.udd = w.cf;
   } else {
-    r.udd.resize(nu);
-    r.udd.noalias() = r.B.transpose() * w.cf;
+    r.udd.setZero(nu);
+    for (int a = 0; a < nf; ++a)
+      for (int c : b_cols_[a]) r.udd[c] += r.B(a, c) * w.cf[a];
   }
   r.reduced.solveInPlace(r.udd);
   r.udd = -r.udd;
   w.qddf = w.beta;
-  w.qddf.noalias() += r.B * r.udd;
+  for (int a = 0; a < nf; ++a)
+    for (int c : b_cols_[a]) w.qddf[a] += r.B(a, c) * r.udd[c];
   for (int a = 0; a < nf; ++a) r.qdd[f_[a]] = w.qddf[a];
 
   // Multipliers: J^T lam = M qdd + c on the dependent rows, M qdd = M B udd + M beta.
@@ -280,12 +331,14 @@ void ReducedDynamics::tangent_dynamics(const Result& r, const double* inputs, co
     return;
   }
   w.dudd.resize(nu(), nd);
-  w.dudd.noalias() = r.B.transpose() * w.drf;
-  w.dudd.noalias() += r.MBf.transpose() * w.dbeta;
+  w.dudd.noalias() = r.MBf.transpose() * w.dbeta;
+  for (int a = 0; a < nf; ++a)  // + B^T drf over B's structure
+    for (int c : b_cols_[a]) w.dudd.row(c) += r.B(a, c) * w.drf.row(a);
   r.reduced.solveInPlace(w.dudd);
   w.dudd = -w.dudd;
-  w.drf = w.dbeta;  // dqdd on the free coordinates
-  w.drf.noalias() += r.B * w.dudd;
+  w.drf = w.dbeta;  // dqdd on the free coordinates: dbeta + B dudd
+  for (int a = 0; a < nf; ++a)
+    for (int c : b_cols_[a]) w.drf.row(a) += r.B(a, c) * w.dudd.row(c);
   for (int a = 0; a < nf; ++a) dqdd.row(f_[a]) = w.drf.row(a);
 }
 

@@ -1,7 +1,9 @@
 // The explicit direct dynamics of a generated model by coordinate partitioning:
 // u independent, v dependent, d driven. Newton-Raphson on h(u, v) = 0 for v, v_dot = -Jv^-1 Ju u_dot,
 // qdd = B udd + beta with B = [I; -Jv^-1 Ju], the reduced system B^T M B udd = -B^T (c + M beta)
-// solved by Cholesky, and the multipliers from the v rows. Its tangent reuses the factors:
+// solved by Cholesky, and the multipliers from the v rows. M [B beta] from M's composite-inertia
+// entries over B's structure (a loop's rows of B are nonzero in its own independent columns
+// only), or from the inertial pass seeded on [B beta]. Its tangent reuses the factors:
 // dv = -Jv^-1 (Ju du + dh/dp dp), and the same Cholesky factor for dudd.
 #pragma once
 
@@ -36,7 +38,7 @@ class ReducedDynamics {
     // Scratch storage sized at the first call and reused, so that a solve and its tangents
     // allocate nothing once the sizes are known (the right-hand side's path).
     struct Work {
-      std::vector<double> hj, res, out, lam_zero;
+      std::vector<double> hj, res, out, lam_zero, mass, s_val;
       Vector beta, cf, Mbeta, full, fv, qddf;
       Matrix Ju, Bv, beta_v, reduced;
       Matrix dinp, dp, dqdd_seed, dout, dh, dv, dbeta_v, dbeta, drf, dudd;
@@ -81,6 +83,14 @@ class ReducedDynamics {
                    Matrix& dqdd) const;
   // Row a of the free coordinates: its place among u (>= 0), or -1 - its place among v.
   std::vector<int> free_place_;
+  // The structure of B = [I; -Jv^-1 Ju] over the free coordinates: the u columns row a can be
+  // nonzero in (its own for a u row; for a v row those entering its loop's constraints, a
+  // corner's two or three of the car's fourteen). M [B beta], B^T M B and the products with B
+  // run over these only.
+  std::vector<std::vector<int>> b_cols_;
+  // [B beta] by rows of q: row j's entries s_start_[j] .. s_start_[j + 1] - 1, at columns s_col_
+  // (nu: beta); free row of coordinate j (-1: driven).
+  std::vector<int> s_start_, s_col_, free_row_of_;
   const GeneratedModel& model_;
   std::vector<int> u_, v_, f_, d_;
   std::vector<double> pad_;  // one zero for arrays of size zero
