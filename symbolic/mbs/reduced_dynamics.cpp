@@ -159,7 +159,7 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   // M [B beta]: M qdd for qdd = B udd + beta is all we need.
   const int k = nu + (m > 0 ? 1 : 0);
   r.MB.resize(n, k);
-  if (model_.mass_matrix && !identity) {
+  if (model_.mass_matrix) {
     // M's structurally nonzero entries by composite inertias times the structurally nonzero
     // entries of [B beta]: a corner's rows meet a corner's two or three columns
     w.mass.resize(std::max(1, model_.mass_entries));
@@ -183,7 +183,7 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
     }
   } else {
     // the inertial pass seeded on [B beta] (nu + 1 directions; M itself, n directions, is never
-    // formed); a tree too deep for M's entries, or one whose B is the identity
+    // formed): a tree too deep for M's entries
     r.seeds.setZero(n, k);  // kept in r: a large tree's n x n blocks would be fresh pages each call
     for (int a = 0; a < nf; ++a) {
       r.seeds.row(f_[a]).head(nu) = r.B.row(a);
