@@ -86,6 +86,7 @@ std::string run_json(const Diagram& d, const RunResult& r) {
       {"sensitivity_rhs_evaluations", s.sens_rhs_evals},
       {"jacobian_evaluations", s.jac_evals},
       {"local_jacobian_refreshes", s.local_jac_evals},
+      {"substeps", s.substeps},
       {"error_test_failures", s.error_test_failures},
       {"nonlinear_iterations", s.nonlinear_iterations},
       {"nonlinear_failures", s.nonlinear_failures},

@@ -41,6 +41,8 @@ struct RunStats {
   long error_test_failures = 0;
   long nonlinear_iterations = 0;
   long nonlinear_failures = 0;    ///< corrector convergence failures (step retried smaller)
+  long substeps = 0;              ///< fixed-step schemes: steps taken as two halves (their Newton
+                                  ///< iteration failed at the full step)
   double cpu_seconds = 0.0;
   double simulated_seconds = 0.0;
   double realtime_factor = 0.0;   ///< simulated seconds per CPU second

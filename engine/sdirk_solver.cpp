@@ -3,6 +3,8 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <string>
 
 #include "engine/cpu_clock.hpp"
 #include "engine/errors.hpp"
@@ -21,6 +23,16 @@ const double kGamma = 1.0 - 1.0 / std::sqrt(2.0);
 /// 0.02 cost 16 %, 7 % and 34 % more).
 const double kSlowRate = 0.1;
 const int kMaxIterations = 30;
+/// A step whose stage iteration fails is taken as two of half the size, down to 1/2^this of
+/// the scene's step; then the run stops naming the step that would do.
+const int kMaxHalvings = 6;
+
+/// A stage's Newton iteration failed (diverged, did not converge, or an iterate was outside a
+/// block's domain): the step is retried in halves.
+struct StageFailure {
+  double t;
+  std::string why;
+};
 
 /// The stages of one step share this: the diagram, the evaluator and the iteration matrix.
 class Stepper {
@@ -74,12 +86,18 @@ class Stepper {
     double previous = 0.0;  // size of the last correction since J was last evaluated
     bool local_last = false;  // the last refresh was of the local blocks only
     for (int it = 0; it < kMaxIterations; ++it) {
-      const Vector residual = y - hg * f(t, y) - rhs;
+      Vector fy;
+      try {
+        fy = f(t, y);
+      } catch (const SolverError& e) {
+        throw StageFailure{t, e.what()};  // an iterate off the solution: not the solution's failure
+      }
+      const Vector residual = y - hg * fy - rhs;
       const Vector delta = lu_.solve(residual);
       y -= delta;
       ++stats_.nonlinear_iterations;
       const double size = delta.cwiseAbs().maxCoeff();
-      if (!std::isfinite(size)) throw SolverError(t, "", "Newton iteration diverged (non-finite iterate)");
+      if (!std::isfinite(size)) throw StageFailure{t, "Newton iteration diverged (non-finite iterate)"};
       // Converged when the remaining error, estimated from the contraction rate theta as
       // theta / (1 - theta) times this correction (or the correction itself before a rate is
       // known), is at rounding level.
@@ -96,8 +114,7 @@ class Stepper {
         previous = size;
       }
     }
-    throw SolverError(t, "", "Newton iteration did not converge in " + std::to_string(kMaxIterations) +
-                                 " iterations (step " + std::to_string(hg / kGamma) + " s too large?)");
+    throw StageFailure{t, "Newton iteration did not converge in " + std::to_string(kMaxIterations) + " iterations"};
   }
 
   /// Stage sensitivity: (I - hg J(Y)) dY = rhs + hg f_p(Y), with J refreshed at Y. Returns dY
@@ -178,19 +195,21 @@ RunResult run_sdirk(const Diagram& d, const RunOptions& options) {
   double t = t0;
   if (nx > 0) stepper.jacobian(t0, x);
   Vector slope = Vector::Zero(nx);  // f at the end of the last step, for the stage-1 predictor
-  for (double target : timeline.events) {
-    const long n = fixed_steps(t, target, h_max);
-    const double h = (target - t) / n, hg = kGamma * h;
-    for (long step = 0; step < n; ++step) {
-      const double tn = t + step * h, t1 = tn + hg, t2 = tn + h;
+  // One step of the scheme over [tn, tn + h]; when a stage's iteration fails, two steps of h / 2
+  // instead (the sensitivities are then those of the two half steps, the map actually taken).
+  std::function<void(double, double, int)> advance = [&](double tn, double h, int halvings) {
+    const double hg = kGamma * h, t1 = tn + hg, t2 = tn + h;
+    try {
       // Y1 = x + h g f(Y1);  Y2 = x + h (1 - g) f(Y1) + h g f(Y2);  x+ = Y2.
       // Predictors: stage 1 extrapolates with the last step's final stage slope, stage 2 with
       // stage 1's slope (both are the slopes the stage equations gave, no extra evaluation).
+      // Nothing is updated before both stages have converged, so a failed step leaves the state
+      // as it was for its halves.
       const Vector y1 = nx ? stepper.solve_stage(t1, hg, x, x + hg * slope) : x;
       const Vector k1 = stepper.f(t1, y1);
       const Vector q1 = stepper.g(t1, y1);
       Matrix dk1, dq1;
-      Matrix dy1 = ns ? stepper.stage_sensitivity(t1, hg, y1, S, dk1, dq1) : Matrix();
+      const Matrix dy1 = ns ? stepper.stage_sensitivity(t1, hg, y1, S, dk1, dq1) : Matrix();
       const Vector rhs2 = x + h * (1 - kGamma) * k1;
       const Vector y2 = nx ? stepper.solve_stage(t2, hg, rhs2, rhs2 + hg * k1) : x;
       if (nx) slope = (y2 - rhs2) / hg;
@@ -204,7 +223,23 @@ RunResult run_sdirk(const Diagram& d, const RunOptions& options) {
       if (nq > 0) q += h * ((1 - kGamma) * q1 + kGamma * q2);
       x = y2;
       ++st.steps;
+    } catch (const StageFailure& failure) {
+      if (halvings == kMaxHalvings)
+        throw SolverError(failure.t, "",
+                          failure.why + " at a step of " + format_number(h) + " s (the scene's step " +
+                              format_number(h_max) + " s halved " + std::to_string(kMaxHalvings) +
+                              " times): the solution changes faster than a fixed step can follow here; use "
+                              "method bdf, or a step of at most " + format_number(h) + " s");
+      ++st.substeps;
+      slope.setZero();  // the predictor only; the stages converge to rounding level from any start
+      advance(tn, h / 2, halvings + 1);
+      advance(tn + h / 2, h / 2, halvings + 1);
     }
+  };
+  for (double target : timeline.events) {
+    const long n = fixed_steps(t, target, h_max);
+    const double h = (target - t) / n;
+    for (long step = 0; step < n; ++step) advance(t + step * h, h, 0);
     t = target;
     if (timeline.is_output(target)) record(target);
     if (timeline.is_break(target)) {
