@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "engine/block_directions.hpp"
 #include "engine/block_reader.hpp"
 #include "engine/consistency_checks.hpp"
 #include "engine/diagram.hpp"
@@ -171,9 +172,14 @@ Diagram load_scene(const std::string& path,
   read_solver(r, root["solver"], d.time, d.solver);
   read_parameters(r, root["parameters"], d);
 
+  // --set of a direction named by block parameters waits until the blocks are read.
+  std::vector<std::pair<std::string, std::string>> direction_overrides;
   for (const auto& [name, text] : overrides) {
     const int i = d.find_parameter(name);
-    if (i < 0) throw InputError("--set", 0, name, "no scene parameter of that name in " + path);
+    if (i < 0) {
+      direction_overrides.emplace_back(name, text);
+      continue;
+    }
     double v = 0;
     if (!parse_number(text, v)) throw InputError("--set", 0, name, "malformed number '" + text + "'");
     SceneParameter& p = d.parameters[i];
@@ -183,17 +189,7 @@ Diagram load_scene(const std::string& path,
     p.value = v;
   }
 
-  if (const YAML::Node s = root["sensitivities"]) {
-    if (!s.IsSequence()) r.fail(s, "sensitivities", "expected a list of scene parameter names");
-    for (auto item : s) {
-      const std::string name = r.text(item, "sensitivities");
-      const int i = d.find_parameter(name);
-      if (i < 0) r.fail(item, "sensitivities", "unknown scene parameter '" + name + "'");
-      if (std::find(d.sensitivities.begin(), d.sensitivities.end(), i) != d.sensitivities.end())
-        r.fail(item, "sensitivities", "'" + name + "' listed twice");
-      d.sensitivities.push_back(i);
-    }
-  }
+  const std::vector<DirectionEntry> directions = read_direction_entries(root["sensitivities"], path, d);
 
   SubsystemLibrary library;
   read_subsystem_section(root["subsystems"], path, library);
@@ -204,6 +200,7 @@ Diagram load_scene(const std::string& path,
   GraphBuilder graph(path);
   SceneFlattener flat(d, graph, setting_overrides, d.warnings);
   flat.add_scene(path, library, blocks, root["connections"]);
+  bind_directions(directions, path, graph.blocks(), d);
 
   // Sensitivity directions must only reach parameters the blocks can differentiate.
   for (const Node& n : graph.blocks())
@@ -221,6 +218,17 @@ Diagram load_scene(const std::string& path,
   for (auto item : outputs) flat.request_output(r.text(item, "outputs"), path, line_of(item));
 
   graph.build(d);
+  for (const auto& [name, text] : direction_overrides) {
+    const int i = d.find_parameter(name);
+    if (i < 0)
+      throw InputError("--set", 0, name, "no scene parameter of that name in " + path + " (nor a direction of its sensitivities)");
+    double v = 0;
+    if (!parse_number(text, v)) throw InputError("--set", 0, name, "malformed number '" + text + "'");
+    const SceneParameter& p = d.parameters[i];
+    if (v < p.lower || v > p.upper)
+      throw InputError(path, p.line, "sensitivities." + name, "--set value " + text + " outside its range");
+    d.set_parameter(i, v);
+  }
   return d;
 }
 

@@ -77,7 +77,8 @@ int main(int argc, char** argv) {
                      "csv: the CSV/JSON files; mat: also replay.mat (MAT v5); rpc: also signals.rsp (RPC III)")
       ->check(CLI::IsMember({"csv", "mat", "rpc"}))->capture_default_str();
 
-  CLI::App* blocks = app.add_subcommand("blocks", "List the block types with ports and parameters");
+  CLI::App* blocks = app.add_subcommand("blocks", "List the block types with ports and parameters; [direction]: a parameter that can be a "
+      "sensitivity direction, written BLOCK.PARAMETER in a scene's sensitivities: list");
 
   try {
     app.parse(argc, argv);
