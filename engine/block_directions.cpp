@@ -34,22 +34,30 @@ std::string parameters_of_prefix(const std::string& path, const std::vector<Node
 }  // namespace
 
 std::vector<DirectionEntry> read_direction_entries(const YAML::Node& list, const std::string& file,
-                                                   const Diagram& d) {
+                                                   const std::string& field, const Diagram& d,
+                                                   const std::vector<DirectionEntry>& declared) {
+  const bool computed = field == "sensitivities";
+  auto is_declared = [&](const std::string& name) {
+    return std::any_of(declared.begin(), declared.end(), [&](const DirectionEntry& e) { return e.name == name; });
+  };
   std::vector<DirectionEntry> entries;
   if (!list) return entries;
   if (!list.IsSequence())
-    throw InputError(file, line_of(list), "sensitivities",
-                     "expected a list of scene parameters, block parameters or groups");
+    throw InputError(file, line_of(list), field,
+                     computed ? "expected a list of scene parameters, block parameters or groups"
+                              : "expected a list of block parameters or groups");
   for (auto item : list) {
     DirectionEntry e;
     e.line = line_of(item);
     if (item.IsScalar()) {
       e.name = item.Scalar();
-      e.scene_parameter = d.find_parameter(e.name) >= 0;
+      e.scene_parameter = d.find_parameter(e.name) >= 0 || is_declared(e.name);
+      if (e.scene_parameter && !computed)
+        throw InputError(file, e.line, field, "'" + e.name + "' is a scene parameter already");
       if (!e.scene_parameter) {
         // Not a scene parameter: a block parameter path, or nothing at all.
         if (e.name.find('.') == std::string::npos)
-          throw InputError(file, e.line, "sensitivities",
+          throw InputError(file, e.line, field,
                            "unknown scene parameter '" + e.name + "' (a block parameter is written block.parameter)");
         e.members = {e.name};
         e.member_lines = {e.line};
@@ -58,59 +66,60 @@ std::vector<DirectionEntry> read_direction_entries(const YAML::Node& list, const
       continue;
     }
     if (!item.IsMap())
-      throw InputError(file, e.line, "sensitivities", "expected a name or a mapping {name, of, range, unit}");
+      throw InputError(file, e.line, field, "expected a name or a mapping {name, of, range, unit}");
     for (auto kv : item) {
       const std::string key = kv.first.Scalar();
       if (key != "name" && key != "of" && key != "range" && key != "unit")
-        throw InputError(file, line_of(kv.first), "sensitivities." + key, "unknown key (name, of, range, unit)");
+        throw InputError(file, line_of(kv.first), field + "." + key, "unknown key (name, of, range, unit)");
     }
     const YAML::Node of = item["of"];
-    if (!of) throw InputError(file, e.line, "sensitivities.of", "missing: the block parameters of the direction");
+    if (!of) throw InputError(file, e.line, field + ".of", "missing: the block parameters of the direction");
     if (of.IsScalar()) {
       e.members = {of.Scalar()};
       e.member_lines = {line_of(of)};
     } else if (of.IsSequence() && of.size() > 0) {
       for (auto m : of) {
-        e.members.push_back(scalar(m, file, "sensitivities.of"));
+        e.members.push_back(scalar(m, file, field + ".of"));
         e.member_lines.push_back(line_of(m));
       }
     } else {
-      throw InputError(file, line_of(of), "sensitivities.of", "expected block.parameter or a list of them");
+      throw InputError(file, line_of(of), field + ".of", "expected block.parameter or a list of them");
     }
     const bool single = e.members.size() == 1 && !has_wildcard(e.members[0]);
     if (item["name"]) {
-      e.name = scalar(item["name"], file, "sensitivities.name");
+      e.name = scalar(item["name"], file, field + ".name");
     } else if (single) {
       e.name = e.members[0];
     } else {
-      throw InputError(file, e.line, "sensitivities.name", "missing: a group of block parameters needs a name");
+      throw InputError(file, e.line, field + ".name", "missing: a group of block parameters needs a name");
     }
     if (e.name.empty() || e.name.front() == '$')
-      throw InputError(file, e.line, "sensitivities.name", "expected a plain name");
-    if (d.find_parameter(e.name) >= 0)
-      throw InputError(file, item["name"] ? line_of(item["name"]) : e.line, "sensitivities.name",
+      throw InputError(file, e.line, field + ".name", "expected a plain name");
+    if (d.find_parameter(e.name) >= 0 || is_declared(e.name))
+      throw InputError(file, item["name"] ? line_of(item["name"]) : e.line, field + ".name",
                        "'" + e.name + "' is a scene parameter already");
     if (const YAML::Node r = item["range"]) {
       if (!r.IsSequence() || r.size() != 2)
-        throw InputError(file, line_of(r), "sensitivities.range", "expected [low, high]");
-      e.lower = scene_number(scalar(r[0], file, "sensitivities.range"), file, line_of(r[0]), "sensitivities.range");
-      e.upper = scene_number(scalar(r[1], file, "sensitivities.range"), file, line_of(r[1]), "sensitivities.range");
-      if (!(e.lower <= e.upper)) throw InputError(file, line_of(r), "sensitivities.range", "low is above high");
+        throw InputError(file, line_of(r), field + ".range", "expected [low, high]");
+      e.lower = scene_number(scalar(r[0], file, field + ".range"), file, line_of(r[0]), field + ".range");
+      e.upper = scene_number(scalar(r[1], file, field + ".range"), file, line_of(r[1]), field + ".range");
+      if (!(e.lower <= e.upper)) throw InputError(file, line_of(r), field + ".range", "low is above high");
       e.has_range = true;
     }
-    if (item["unit"]) e.unit = scalar(item["unit"], file, "sensitivities.unit");
+    if (item["unit"]) e.unit = scalar(item["unit"], file, field + ".unit");
     entries.push_back(std::move(e));
   }
   for (size_t a = 0; a < entries.size(); ++a)
     for (size_t b = 0; b < a; ++b)
       if (entries[a].name == entries[b].name)
-        throw InputError(file, entries[a].line, "sensitivities",
+        throw InputError(file, entries[a].line, field,
                          "'" + entries[a].name + "' listed twice (also line " + std::to_string(entries[b].line) + ")");
   return entries;
 }
 
 void bind_directions(const std::vector<DirectionEntry>& entries, const std::string& file,
-                     std::vector<Node>& nodes, Diagram& d) {
+                     std::vector<Node>& nodes, Diagram& d, bool compute) {
+  const std::string list = compute ? "sensitivities" : "directions";
   // Block parameter (node, index) -> the entry that claimed it, to refuse naming one twice.
   std::vector<std::vector<int>> claimed(nodes.size());
   for (size_t i = 0; i < nodes.size(); ++i) claimed[i].assign(nodes[i].p.size(), -1);
@@ -118,13 +127,14 @@ void bind_directions(const std::vector<DirectionEntry>& entries, const std::stri
   for (size_t k = 0; k < entries.size(); ++k) {
     const DirectionEntry& e = entries[k];
     if (e.scene_parameter) {
-      d.sensitivities.push_back(d.find_parameter(e.name));
+      if (compute) d.sensitivities.push_back(d.find_parameter(e.name));
       continue;
     }
-    const std::string field = "sensitivities." + e.name;
+    const std::string field = list + "." + e.name;
     SceneParameter sp;
     sp.name = e.name;
     sp.line = e.line;
+    sp.direction_list = list;
     bool first = true;
     std::string first_path;
     std::vector<std::pair<size_t, size_t>> bound;
@@ -143,6 +153,10 @@ void bind_directions(const std::vector<DirectionEntry>& entries, const std::stri
             throw InputError(file, line, field,
                              path + " is already in direction '" + entries[claimed[i][j]].name + "' (line " +
                                  std::to_string(entries[claimed[i][j]].line) + ")");
+          if (n.p_scene[j] >= 0 && !d.parameters[n.p_scene[j]].direction_list.empty())
+            throw InputError(file, line, field,
+                             path + " is already in direction '" + d.parameters[n.p_scene[j]].name + "' (line " +
+                                 std::to_string(d.parameters[n.p_scene[j]].line) + ")");
           if (n.p_scene[j] >= 0)
             throw InputError(file, line, field,
                              path + " is driven by scene parameter '" + d.parameters[n.p_scene[j]].name + "' (" +
@@ -196,7 +210,7 @@ void bind_directions(const std::vector<DirectionEntry>& entries, const std::stri
     const int index = static_cast<int>(d.parameters.size());
     d.parameters.push_back(sp);
     for (auto [i, j] : bound) nodes[i].p_scene[j] = index;
-    d.sensitivities.push_back(index);
+    if (compute) d.sensitivities.push_back(index);
   }
 }
 

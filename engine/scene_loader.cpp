@@ -162,7 +162,7 @@ Diagram load_scene(const std::string& path,
   if (!root.IsMap()) throw InputError(path, 1, "", "a scene is a YAML mapping");
   refuse_duplicate_keys(root, path);
   r.allow_keys(root, "", {"scene", "description", "time", "solver", "parameters",
-                               "sensitivities", "subsystems", "blocks", "connections", "outputs",
+                               "sensitivities", "directions", "subsystems", "blocks", "connections", "outputs",
                           "layout"});
 
   Diagram d;
@@ -189,7 +189,9 @@ Diagram load_scene(const std::string& path,
     p.value = v;
   }
 
-  const std::vector<DirectionEntry> directions = read_direction_entries(root["sensitivities"], path, d);
+  const std::vector<DirectionEntry> declared = read_direction_entries(root["directions"], path, "directions", d);
+  const std::vector<DirectionEntry> directions =
+      read_direction_entries(root["sensitivities"], path, "sensitivities", d, declared);
 
   SubsystemLibrary library;
   read_subsystem_section(root["subsystems"], path, library);
@@ -200,17 +202,10 @@ Diagram load_scene(const std::string& path,
   GraphBuilder graph(path);
   SceneFlattener flat(d, graph, setting_overrides, d.warnings);
   flat.add_scene(path, library, blocks, root["connections"]);
-  bind_directions(directions, path, graph.blocks(), d);
+  bind_directions(declared, path, graph.blocks(), d, /*compute=*/false);
+  bind_directions(directions, path, graph.blocks(), d, /*compute=*/true);
 
-  // Sensitivity directions must only reach parameters the blocks can differentiate.
-  for (const Node& n : graph.blocks())
-    for (size_t j = 0; j < n.p.size(); ++j)
-      if (n.p_scene[j] >= 0 && !n.type->parameters[j].differentiable &&
-          std::find(d.sensitivities.begin(), d.sensitivities.end(), n.p_scene[j]) !=
-              d.sensitivities.end())
-        throw InputError(n.parameter_file(j, path), n.p_line[j], n.name + "." + n.type->parameters[j].name,
-                         "not differentiable, cannot be driven by sensitivity parameter '" +
-                             d.parameters[n.p_scene[j]].name + "'");
+  check_differentiable(graph.blocks(), d, d.sensitivities);
 
   const YAML::Node outputs = root["outputs"];
   if (!outputs || !outputs.IsSequence() || outputs.size() == 0)
@@ -226,7 +221,7 @@ Diagram load_scene(const std::string& path,
     if (!parse_number(text, v)) throw InputError("--set", 0, name, "malformed number '" + text + "'");
     const SceneParameter& p = d.parameters[i];
     if (v < p.lower || v > p.upper)
-      throw InputError(path, p.line, "sensitivities." + name, "--set value " + text + " outside its range");
+      throw InputError(path, p.line, p.direction_list + "." + name, "--set value " + text + " outside its range");
     d.set_parameter(i, v);
   }
   return d;
@@ -253,6 +248,21 @@ std::string Diagram::objective_unit(const Node& n) const {
   return n.objective->unit(n.input_source.empty() ? std::string() : signal_unit(n.input_source[0]));
 }
 
+void check_differentiable(const std::vector<Node>& nodes, const Diagram& d, const std::vector<int>& directions) {
+  for (const Node& n : nodes)
+    for (size_t j = 0; j < n.p.size(); ++j)
+      if (n.p_scene[j] >= 0 && !n.type->parameters[j].differentiable &&
+          std::find(directions.begin(), directions.end(), n.p_scene[j]) != directions.end())
+        throw InputError(n.parameter_file(j, d.file), n.p_line[j], n.name + "." + n.type->parameters[j].name,
+                         "not differentiable, cannot be driven by sensitivity parameter '" +
+                             d.parameters[n.p_scene[j]].name + "'");
+}
+
+void Diagram::set_sensitivities(const std::vector<int>& directions) {
+  check_differentiable(nodes, *this, directions);
+  sensitivities = directions;
+}
+
 int Diagram::find_parameter(const std::string& name) const {
   for (size_t i = 0; i < parameters.size(); ++i)
     if (parameters[i].name == name) return static_cast<int>(i);
@@ -262,7 +272,7 @@ int Diagram::find_parameter(const std::string& name) const {
 void Diagram::set_parameter(int index, double value, bool check_range) {
   SceneParameter& sp = parameters.at(index);
   if (check_range && (value < sp.lower || value > sp.upper))
-    throw InputError(file, sp.line, "parameters." + sp.name,
+    throw InputError(file, sp.line, (sp.direction_list.empty() ? "parameters." : sp.direction_list + ".") + sp.name,
                      "value " + format_number(value) + " outside its range");
   // Check every block parameter it drives before changing any: a refused value leaves none behind.
   for (const Node& n : nodes)

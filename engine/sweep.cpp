@@ -67,7 +67,7 @@ SweepResult sweep(const SweepSpec& spec) {
         Diagram d = load(spec);
         d.set_parameter(index, pt.p);
         // The swept parameter is the one sensitivity direction the sweep needs.
-        d.sensitivities = {index};
+        d.set_sensitivities({index});
         RunResult r = run(d);
         for (const auto& obj : r.objectives) {
           pt.psi.push_back(obj.value);

@@ -178,5 +178,38 @@ TEST_F(BlockDirections, MalformedEntriesAreRefusedWhereWritten) {
   expect_error(load_error(clash), clash, 7, "sensitivities.name", "is a scene parameter already");
 }
 
+TEST_F(BlockDirections, DeclaredDirectionsAreSceneParametersComputedOnlyWhenListed) {
+  const std::string declared = two_masses("", "directions:\n  - {name: springs, of: \"body*.k\", range: [20.0, 80.0]}\n  - body1.c\n");
+  const std::string quiet = write("q.yaml", declared);
+  const Diagram q = load_scene(quiet);
+  EXPECT_TRUE(q.sensitivities.empty());
+  const int springs = q.find_parameter("springs");
+  ASSERT_GE(springs, 0);
+  EXPECT_EQ(q.parameters[springs].direction_list, "directions");
+  EXPECT_GE(q.find_parameter("body1.c"), 0);
+  const std::string listed = write("l.yaml", declared + "sensitivities: [body1.c, springs]\n");
+  const Diagram l = load_scene(listed);
+  ASSERT_EQ(l.sensitivities.size(), 2u);
+  EXPECT_EQ(l.sensitivities[0], l.find_parameter("body1.c"));
+  EXPECT_EQ(l.sensitivities[1], l.find_parameter("springs"));
+  // A declared direction's block parameter cannot be named again in sensitivities.
+  const std::string again = write("a.yaml", declared + "sensitivities: [body2.k]\n");
+  expect_error(load_error(again), again, 19, "sensitivities.body2.k", "already in direction 'springs' (line 5)");
+  const std::string scene_param = write("s.yaml", two_masses("parameters:\n  k1: 3.0\n", "directions: [k1]\n"));
+  expect_error(load_error(scene_param), scene_param, 6, "directions", "is a scene parameter already");
+  // set_sensitivities refuses a direction that reaches a parameter its block cannot differentiate.
+  std::string step = two_masses("parameters:\n  t1: 0.5\n", "");
+  step.replace(step.find("blocks:\n"), 8, "blocks:\n  st: {type: source.step, after: 1.0, time: $t1}\n");
+  step.replace(step.find("outputs: [x1, x2]"), 17, "outputs: [x1, x2, st.y]");
+  const std::string step_path = write("t.yaml", step);
+  Diagram t = load_scene(step_path);
+  try {
+    t.set_sensitivities({t.find_parameter("t1")});
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    expect_error(e, step_path, 7, "st.time", "not differentiable");
+  }
+}
+
 }  // namespace
 }  // namespace dydp::engine
