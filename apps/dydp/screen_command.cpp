@@ -40,7 +40,7 @@ std::string measures_csv(const engine::ScreenResult& r) {
   return out.str();
 }
 
-/// Every run: its point, psi and gradient per objective.
+/// Every run (run 0: the nominal point, then the samples): its point, psi and gradient per objective.
 std::string samples_csv(const engine::ScreenResult& r) {
   std::ostringstream out;
   out.precision(17);
@@ -52,7 +52,7 @@ std::string samples_csv(const engine::ScreenResult& r) {
   }
   out << ",cpu_seconds\n";
   auto row = [&](const engine::ScreenRun& s) {
-    out << (s.index == 0 ? std::string("nominal") : std::to_string(s.index));
+    out << s.index;
     for (double p : s.p) out << ',' << p;
     for (size_t o = 0; o < r.objectives.size(); ++o) {
       out << ',' << s.psi[o];
