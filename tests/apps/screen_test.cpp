@@ -169,6 +169,29 @@ TEST_F(Screen, MeasuresFollowFromTheSamplesAndGradientsFromSingleRuns) {
   EXPECT_EQ(o["sensitivity"]["damping"].get<double>(), dc[5]);
 }
 
+TEST_F(Screen, ReportShowsTheRankingAsATornadoAndTheSamplesOfEachParameter) {
+  const fs::path out = dir_ / "out";
+  const ProcessResult r = dydp("screen " + quote(source_path("scenarios/msd_sensitivity.yaml").string()) +
+                               " --params mass,stiffness,damping --samples 8 --report --out " + quote(out.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string md = read_text(out / "report.md");
+  ASSERT_NE(md.find("# Screening of 3 parameters"), std::string::npos) << md;
+  if (md.find("gnuplot was not found") != std::string::npos) GTEST_SKIP() << "gnuplot not on the PATH";
+  for (const char* png : {"plots/tornado_x_rms.png", "plots/samples_x_rms.png"}) {
+    EXPECT_NE(md.find(std::string("](") + png + ")"), std::string::npos) << png;
+    ASSERT_TRUE(fs::exists(out / png)) << png;
+    EXPECT_GT(fs::file_size(out / png), 1000u) << png;
+  }
+  // The tornado's bars, top (y = 3) to bottom, are the ranking of screen.json.
+  const json ranking = json::parse(read_text(out / "screen.json"))["objectives"]["x_rms"]["ranking"];
+  std::istringstream bars(read_text(out / "plots/tornado_x_rms.dat"));
+  std::string line;
+  for (int rank = 0; std::getline(bars, line); ++rank) {
+    EXPECT_EQ(line.substr(0, 2), std::to_string(3 - rank) + " ") << line;
+    EXPECT_NE(line.find("\"" + ranking[rank].get<std::string>() + " (S_T <= "), std::string::npos) << line;
+  }
+}
+
 TEST_F(Screen, BadParametersAndSampleCountsAreRefusedWithoutOutput) {
   const std::string scene = write("s.yaml", R"(scene: s
 time: {stop: 1.0, output_step: 0.1}
