@@ -54,6 +54,7 @@ void write_screen_report(const std::string& dir, const std::string& scene, const
     // range's low and high ends at the mean slope; the label gives the bound on S_Ti.
     std::ostringstream tornado;
     tornado << std::setprecision(12);
+    size_t longest = 0;
     for (int rank = 0; rank < P; ++rank) {
       const int i = e.ranking[rank];
       const auto& m = e.parameters[i];
@@ -61,6 +62,7 @@ void write_screen_report(const std::string& dir, const std::string& scene, const
       const double high = m.mean_gradient * (r.ranges[i].upper - r.ranges[i].nominal);
       std::ostringstream label;
       label << std::setprecision(2) << r.ranges[i].name << " (S_T <= " << m.total_index_bound << ")";
+      longest = std::max(longest, label.str().size());
       tornado << P - rank << ' ' << std::min(low, high) << ' ' << std::max(low, high) << ' ' << high << " \""
               << label.str() << "\"\n";
     }
@@ -69,7 +71,7 @@ void write_screen_report(const std::string& dir, const std::string& scene, const
        << "set title '" << r.objectives[o] << ": psi at the ends of each range (mean slope), ranked'\n"
        << "set xlabel 'psi - psi_nominal" << (ou.empty() ? "" : " [" + ou + "]") << "'\nunset ylabel\n"
        << "set yrange [0.4:" << P + 0.6 << "]\nset ytics scale 0\nset style fill solid 0.8 border -1\nset key bottom right\n"
-       << "set lmargin 36\n"
+       << "set lmargin " << longest + 2 << "\n"
        << "plot '" << dir << "/plots/tornado_" << name << ".dat' using (($2+$3)/2):1:2:3:($1-0.35):($1+0.35):ytic(5) "
        << "with boxxyerror lc rgb '#4575b4' title 'low end to high end', '' using 4:1 with points pt 7 lc rgb '#d73027' "
        << "title 'high end'\n"
