@@ -211,5 +211,37 @@ TEST_F(BlockDirections, DeclaredDirectionsAreSceneParametersComputedOnlyWhenList
   }
 }
 
+TEST_F(BlockDirections, ShippedSedanScenesDeclareTheirSuspensionDirectionsWithoutComputingThem) {
+  const std::string scenes = std::string(DYDP_SOURCE_DIR) + "/scenarios/";
+  struct Expected {
+    const char* scene;
+    std::vector<std::pair<const char*, int>> members;  ///< direction, block parameters it drives
+    const char* computed;                              ///< the scene's one sensitivity
+  };
+  for (const Expected& x : {Expected{"fourposter_comfort.yaml",
+                                     {{"piston_rebound_section", 4}, {"damper_friction", 4}, {"spring_front", 2},
+                                      {"spring_rear", 2}, {"tyre_stiffness", 4}, {"gas_precharge", 4}},
+                                     "valve_current"},
+                            Expected{"cornering_arb.yaml",
+                                     {{"valve_current", 4}, {"piston_check_section", 4}, {"arb_lever_front", 1}},
+                                     "arb_front"}}) {
+    SCOPED_TRACE(x.scene);
+    const Diagram d = load_scene(scenes + x.scene);
+    ASSERT_EQ(d.sensitivities.size(), 1u);
+    EXPECT_EQ(d.parameters[d.sensitivities[0]].name, x.computed);
+    for (const auto& [name, count] : x.members) {
+      const int i = d.find_parameter(name);
+      ASSERT_GE(i, 0) << name;
+      const SceneParameter& p = d.parameters[i];
+      EXPECT_EQ(p.direction_list, "directions") << name;
+      EXPECT_TRUE(std::isfinite(p.lower) && std::isfinite(p.upper) && p.lower < p.value && p.value < p.upper) << name;
+      int driven = 0;
+      for (const Node& n : d.nodes)
+        for (int s : n.p_scene) driven += s == i;
+      EXPECT_EQ(driven, count) << name;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace dydp::engine
