@@ -120,8 +120,11 @@ TEST_F(BlockDirections, AGroupIsTheSumOfItsMembersAndMatchesCentralDifferences) 
 TEST_F(BlockDirections, SetReachesADirectionNamedByBlockParameters) {
   const std::string path = write("s.yaml", two_masses("", "sensitivities:\n  - {name: springs, of: [body1.k, body2.k], range: [20.0, 80.0]}\n"));
   const Diagram d = load_scene(path, {{"springs", "50"}});
-  for (const Node& n : d.nodes)
-    if (n.name == "body1" || n.name == "body2") EXPECT_EQ(n.p[1], 50.0) << n.name;
+  for (const Node& n : d.nodes) {
+    if (n.name == "body1" || n.name == "body2") {
+      EXPECT_EQ(n.p[1], 50.0) << n.name;
+    }
+  }
   expect_error(load_error(path, {{"springs", "90"}}), path, 5, "sensitivities.springs", "outside its range");
   expect_error(load_error(path, {{"sprngs", "50"}}), "--set", 0, "sprngs", "no scene parameter of that name");
 }
