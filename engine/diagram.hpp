@@ -45,6 +45,10 @@ struct SceneParameter {
   double lower = -std::numeric_limits<double>::infinity();
   double upper = std::numeric_limits<double>::infinity();
   int line = 0;
+  /// A direction named by block parameters: the list of its entry (`directions` or
+  /// `sensitivities`, its messages name that list; `line` is the entry's); empty for a
+  /// parameter written under `parameters:`.
+  std::string direction_list;
 };
 
 struct Node {
@@ -123,6 +127,9 @@ class Diagram {
   /// Sets a scene parameter and every block parameter it drives; checks the bounds of both
   /// (the scene parameter's range only with check_range: finite differences step past it).
   void set_parameter(int index, double value, bool check_range = true);
+  /// Makes these scene parameters the sensitivity directions; throws InputError (at the block
+  /// parameter's line) when one drives a parameter its block cannot differentiate.
+  void set_sensitivities(const std::vector<int>& directions);
   /// Seed of block parameter j of node n in sensitivity direction d.
   double parameter_seed(const Node& n, int j, int d) const {
     return n.p_scene[j] >= 0 && n.p_scene[j] == sensitivities[d] ? 1.0 : 0.0;
@@ -130,6 +137,10 @@ class Diagram {
   /// All breakpoints of the kept blocks in (t0, t1], sorted, unique.
   std::vector<double> breakpoints(double t0, double t1) const;
 };
+
+/// Throws InputError when one of `directions` drives a block parameter of `nodes` that its block
+/// cannot differentiate.
+void check_differentiable(const std::vector<Node>& nodes, const Diagram& d, const std::vector<int>& directions);
 
 /// Loads a scene file; overrides are --set NAME=VALUE pairs for scene parameters;
 /// setting_overrides (SETTING, VALUE) replace that setting in every block whose type declares

@@ -18,6 +18,8 @@ class GraphBuilder {
   /// Node::file empty: the scene's file.
   void add_block(Node node);
   const std::vector<Node>& blocks() const { return nodes_; }
+  /// The blocks read so far, for binding sensitivity directions to their parameters.
+  std::vector<Node>& blocks() { return nodes_; }
 
   /// A block's port by (flat) block name, written at file:line; throws InputError naming the
   /// known ports when there is none (`file` empty: the scene's file).

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "engine/block_directions.hpp"
 #include "engine/block_reader.hpp"
 #include "engine/consistency_checks.hpp"
 #include "engine/diagram.hpp"
@@ -161,7 +162,7 @@ Diagram load_scene(const std::string& path,
   if (!root.IsMap()) throw InputError(path, 1, "", "a scene is a YAML mapping");
   refuse_duplicate_keys(root, path);
   r.allow_keys(root, "", {"scene", "description", "time", "solver", "parameters",
-                               "sensitivities", "subsystems", "blocks", "connections", "outputs",
+                               "sensitivities", "directions", "subsystems", "blocks", "connections", "outputs",
                           "layout"});
 
   Diagram d;
@@ -171,9 +172,14 @@ Diagram load_scene(const std::string& path,
   read_solver(r, root["solver"], d.time, d.solver);
   read_parameters(r, root["parameters"], d);
 
+  // --set of a direction named by block parameters waits until the blocks are read.
+  std::vector<std::pair<std::string, std::string>> direction_overrides;
   for (const auto& [name, text] : overrides) {
     const int i = d.find_parameter(name);
-    if (i < 0) throw InputError("--set", 0, name, "no scene parameter of that name in " + path);
+    if (i < 0) {
+      direction_overrides.emplace_back(name, text);
+      continue;
+    }
     double v = 0;
     if (!parse_number(text, v)) throw InputError("--set", 0, name, "malformed number '" + text + "'");
     SceneParameter& p = d.parameters[i];
@@ -183,17 +189,9 @@ Diagram load_scene(const std::string& path,
     p.value = v;
   }
 
-  if (const YAML::Node s = root["sensitivities"]) {
-    if (!s.IsSequence()) r.fail(s, "sensitivities", "expected a list of scene parameter names");
-    for (auto item : s) {
-      const std::string name = r.text(item, "sensitivities");
-      const int i = d.find_parameter(name);
-      if (i < 0) r.fail(item, "sensitivities", "unknown scene parameter '" + name + "'");
-      if (std::find(d.sensitivities.begin(), d.sensitivities.end(), i) != d.sensitivities.end())
-        r.fail(item, "sensitivities", "'" + name + "' listed twice");
-      d.sensitivities.push_back(i);
-    }
-  }
+  const std::vector<DirectionEntry> declared = read_direction_entries(root["directions"], path, "directions", d);
+  const std::vector<DirectionEntry> directions =
+      read_direction_entries(root["sensitivities"], path, "sensitivities", d, declared);
 
   SubsystemLibrary library;
   read_subsystem_section(root["subsystems"], path, library);
@@ -204,16 +202,10 @@ Diagram load_scene(const std::string& path,
   GraphBuilder graph(path);
   SceneFlattener flat(d, graph, setting_overrides, d.warnings);
   flat.add_scene(path, library, blocks, root["connections"]);
+  bind_directions(declared, path, graph.blocks(), d, /*compute=*/false);
+  bind_directions(directions, path, graph.blocks(), d, /*compute=*/true);
 
-  // Sensitivity directions must only reach parameters the blocks can differentiate.
-  for (const Node& n : graph.blocks())
-    for (size_t j = 0; j < n.p.size(); ++j)
-      if (n.p_scene[j] >= 0 && !n.type->parameters[j].differentiable &&
-          std::find(d.sensitivities.begin(), d.sensitivities.end(), n.p_scene[j]) !=
-              d.sensitivities.end())
-        throw InputError(n.parameter_file(j, path), n.p_line[j], n.name + "." + n.type->parameters[j].name,
-                         "not differentiable, cannot be driven by sensitivity parameter '" +
-                             d.parameters[n.p_scene[j]].name + "'");
+  check_differentiable(graph.blocks(), d, d.sensitivities);
 
   const YAML::Node outputs = root["outputs"];
   if (!outputs || !outputs.IsSequence() || outputs.size() == 0)
@@ -221,6 +213,17 @@ Diagram load_scene(const std::string& path,
   for (auto item : outputs) flat.request_output(r.text(item, "outputs"), path, line_of(item));
 
   graph.build(d);
+  for (const auto& [name, text] : direction_overrides) {
+    const int i = d.find_parameter(name);
+    if (i < 0)
+      throw InputError("--set", 0, name, "no scene parameter of that name in " + path + " (nor a direction of its sensitivities)");
+    double v = 0;
+    if (!parse_number(text, v)) throw InputError("--set", 0, name, "malformed number '" + text + "'");
+    const SceneParameter& p = d.parameters[i];
+    if (v < p.lower || v > p.upper)
+      throw InputError(path, p.line, p.direction_list + "." + name, "--set value " + text + " outside its range");
+    d.set_parameter(i, v);
+  }
   return d;
 }
 
@@ -245,6 +248,21 @@ std::string Diagram::objective_unit(const Node& n) const {
   return n.objective->unit(n.input_source.empty() ? std::string() : signal_unit(n.input_source[0]));
 }
 
+void check_differentiable(const std::vector<Node>& nodes, const Diagram& d, const std::vector<int>& directions) {
+  for (const Node& n : nodes)
+    for (size_t j = 0; j < n.p.size(); ++j)
+      if (n.p_scene[j] >= 0 && !n.type->parameters[j].differentiable &&
+          std::find(directions.begin(), directions.end(), n.p_scene[j]) != directions.end())
+        throw InputError(n.parameter_file(j, d.file), n.p_line[j], n.name + "." + n.type->parameters[j].name,
+                         "not differentiable, cannot be driven by sensitivity parameter '" +
+                             d.parameters[n.p_scene[j]].name + "'");
+}
+
+void Diagram::set_sensitivities(const std::vector<int>& directions) {
+  check_differentiable(nodes, *this, directions);
+  sensitivities = directions;
+}
+
 int Diagram::find_parameter(const std::string& name) const {
   for (size_t i = 0; i < parameters.size(); ++i)
     if (parameters[i].name == name) return static_cast<int>(i);
@@ -254,7 +272,7 @@ int Diagram::find_parameter(const std::string& name) const {
 void Diagram::set_parameter(int index, double value, bool check_range) {
   SceneParameter& sp = parameters.at(index);
   if (check_range && (value < sp.lower || value > sp.upper))
-    throw InputError(file, sp.line, "parameters." + sp.name,
+    throw InputError(file, sp.line, (sp.direction_list.empty() ? "parameters." : sp.direction_list + ".") + sp.name,
                      "value " + format_number(value) + " outside its range");
   // Check every block parameter it drives before changing any: a refused value leaves none behind.
   for (const Node& n : nodes)

@@ -1,12 +1,9 @@
 #include "engine/sweep.hpp"
 
-#include <algorithm>
-#include <atomic>
-#include <exception>
-#include <mutex>
-#include <thread>
+#include <nlohmann/json.hpp>
 
 #include "engine/errors.hpp"
+#include "engine/run_sharing.hpp"
 
 namespace dydp::engine {
 namespace {
@@ -57,44 +54,56 @@ SweepResult sweep(const SweepSpec& spec) {
     result.points[k].p = spec.points == 1 ? spec.low
                                           : spec.low + (spec.high - spec.low) * k / (spec.points - 1);
 
-  std::atomic<int> next{0};
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  auto worker = [&] {
-    for (int k = next++; k < spec.points; k = next++) {
-      try {
-        SweepPoint& pt = result.points[k];
-        Diagram d = load(spec);
-        d.set_parameter(index, pt.p);
-        // The swept parameter is the one sensitivity direction the sweep needs.
-        d.sensitivities = {index};
-        RunResult r = run(d);
-        for (const auto& obj : r.objectives) {
-          pt.psi.push_back(obj.value);
-          pt.dpsi.push_back(obj.sensitivity[0]);
-        }
-        pt.stats = r.stats;
-        for (double h : spec.fd_steps) {
-          const std::vector<double> plus = objectives_at(spec, index, pt.p + h);
-          const std::vector<double> minus = objectives_at(spec, index, pt.p - h);
-          std::vector<double> fd;
-          for (size_t o = 0; o < plus.size(); ++o) fd.push_back((plus[o] - minus[o]) / (2 * h));
-          pt.fd.push_back(fd);
-        }
-        if (spec.keep_runs) pt.run = std::move(r);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(failure_mutex);
-        if (!failure) failure = std::current_exception();
-        next = spec.points;
-      }
+  // Each point is one run (plus its finite differences) whose numbers travel as a JSON record:
+  // the same text whether it was computed by a thread of this process or by another MPI rank.
+  auto run_point = [&](int k) {
+    const double p = result.points[k].p;
+    Diagram d = load(spec);
+    d.set_parameter(index, p);
+    // The swept parameter is the one sensitivity direction the sweep needs.
+    d.set_sensitivities({index});
+    const RunResult r = run(d);
+    nlohmann::json j;
+    for (const auto& obj : r.objectives) {
+      j["psi"].push_back(obj.value);
+      j["dpsi"].push_back(obj.sensitivity[0]);
+    }
+    j["cpu_seconds"] = r.stats.cpu_seconds;
+    j["steps"] = r.stats.steps;
+    j["fd"] = nlohmann::json::array();
+    for (double h : spec.fd_steps) {
+      const std::vector<double> plus = objectives_at(spec, index, p + h);
+      const std::vector<double> minus = objectives_at(spec, index, p - h);
+      std::vector<double> fd;
+      for (size_t o = 0; o < plus.size(); ++o) fd.push_back((plus[o] - minus[o]) / (2 * h));
+      j["fd"].push_back(fd);
+    }
+    if (spec.keep_runs)
+      j["run"] = {{"signal_names", r.signal_names}, {"sensitivity_names", r.sensitivity_names}, {"t", r.t},
+                  {"values", r.values}, {"tangents", r.tangents}};
+    return j.dump();
+  };
+  auto record = [&](int k, const std::string& text) {
+    const auto j = nlohmann::json::parse(text);
+    SweepPoint& pt = result.points[k];
+    pt.psi = j["psi"].get<std::vector<double>>();
+    pt.dpsi = j["dpsi"].get<std::vector<double>>();
+    pt.fd = j["fd"].get<std::vector<std::vector<double>>>();
+    pt.stats.cpu_seconds = j["cpu_seconds"];
+    pt.stats.steps = j["steps"];
+    if (j.contains("run")) {
+      const auto& run = j["run"];
+      pt.run.signal_names = run["signal_names"].get<std::vector<std::string>>();
+      pt.run.sensitivity_names = run["sensitivity_names"].get<std::vector<std::string>>();
+      pt.run.t = run["t"].get<std::vector<double>>();
+      pt.run.values = run["values"].get<std::vector<double>>();
+      pt.run.tangents = run["tangents"].get<std::vector<double>>();
     }
   };
-  const int threads = std::max(1, std::min(spec.points, spec.threads > 0 ? spec.threads
-                                                  : static_cast<int>(std::thread::hardware_concurrency())));
-  std::vector<std::thread> pool;
-  for (int i = 0; i < threads; ++i) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
-  if (failure) std::rethrow_exception(failure);
+  std::vector<int> todo(spec.points);
+  for (int k = 0; k < spec.points; ++k) todo[k] = k;
+  share_runs(todo, run_point, record, spec.threads > 0 ? spec.threads : (world_size() > 1 ? 1 : 0));
+  result.complete = world_rank() == 0;
   return result;
 }
 

@@ -1,5 +1,5 @@
 // Parameter sweeps: psi and d(psi)/dp at each point of a range of one scene parameter, runs
-// spread over the machine's cores; optionally central finite differences at given steps, to
+// spread over the machine's cores (and over MPI ranks under mpirun, engine/run_sharing.hpp); optionally central finite differences at given steps, to
 // show their error against the exact derivative.
 #pragma once
 
@@ -28,8 +28,8 @@ struct SweepPoint {
   std::vector<double> psi;            ///< per objective
   std::vector<double> dpsi;           ///< per objective, d(psi)/dp for the swept parameter
   std::vector<std::vector<double>> fd;  ///< fd[s][o]: central difference with step s
-  RunStats stats;
-  RunResult run;                      ///< when keep_runs
+  RunStats stats;                     ///< cpu_seconds and steps only
+  RunResult run;                      ///< when keep_runs: names, t, values, tangents
 };
 
 struct SweepResult {
@@ -38,9 +38,11 @@ struct SweepResult {
   std::vector<std::string> objective_units;  ///< unit of each objective's psi
   std::vector<double> fd_steps;
   std::vector<SweepPoint> points;
+  bool complete = true;  ///< false on MPI ranks other than 0 (their points are not filled)
 };
 
-/// Runs the sweep; throws InputError for a bad spec, SolverError when a run fails.
+/// Runs the sweep; throws InputError for a bad spec, SolverError when a run fails (under MPI:
+/// on rank 0).
 SweepResult sweep(const SweepSpec& spec);
 
 }  // namespace dydp::engine

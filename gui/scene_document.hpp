@@ -98,6 +98,9 @@ struct SceneDocument {
   Fields solver;
   std::vector<DocParameter> parameters;
   std::vector<std::string> sensitivities;
+  /// The `directions:` list (directions named by block parameters, docs/scenes.md) as YAML text,
+  /// kept on save as it was read; empty when the scene has none. The GUI does not edit it.
+  std::string directions;
   std::vector<DocSubsystem> subsystems;
   std::vector<DocBlock> blocks;
   std::vector<DocConnection> connections;

@@ -177,6 +177,11 @@ SceneDocument parse_scene(const std::string& text, const std::string& file) {
       for (auto p : v) doc.parameters.push_back(read_parameter(r, p.first.Scalar(), p.second));
     } else if (key == "sensitivities") {
       doc.sensitivities = r.list(v, key);
+    } else if (key == "directions") {
+      if (!v.IsSequence()) r.fail(v, key, "expected a list of block parameters or groups");
+      YAML::Emitter text;
+      text << v;
+      doc.directions = text.c_str();
     } else if (key == "subsystems") {
       doc.subsystems = read_subsystems(v, file);
     } else if (key == "blocks") {
@@ -239,6 +244,7 @@ std::string write_scene(const SceneDocument& doc) {
     }
     e << YAML::EndMap;
   }
+  if (!doc.directions.empty()) e << YAML::Key << "directions" << YAML::Value << YAML::Load(doc.directions);
   if (!doc.sensitivities.empty())
     e << YAML::Key << "sensitivities" << YAML::Value << YAML::Flow << doc.sensitivities;
   emit_subsystems(e, doc.subsystems);

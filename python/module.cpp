@@ -36,7 +36,7 @@ PYBIND11_MODULE(dydp, m) {
   m.doc() =
       "dydp: exact sensitivities of vehicle comfort and handling to design parameters.\n"
       "load() a scene, run() it: numpy arrays of signals and their sensitivities, objectives\n"
-      "with their gradients, run statistics; sweep() a parameter; blocks() lists the library.";
+      "with their gradients, run statistics; sweep() a parameter; screen() many over their ranges; blocks() lists the library.";
 
   // Exception classes made here so that they carry attributes: InputError is a ValueError with
   // file, line and field; SolverError a RuntimeError with time and block.
@@ -67,5 +67,6 @@ PYBIND11_MODULE(dydp, m) {
 
   dydp::python::add_scene_bindings(m);
   dydp::python::add_sweep_bindings(m);
+  dydp::python::add_screen_bindings(m);
   dydp::python::add_block_bindings(m);
 }

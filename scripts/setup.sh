@@ -9,6 +9,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev
   gnuplot-nox liborocos-kdl-dev
   qt6-base-dev qt6-charts-dev libqt6opengl6-dev libgl-dev
+  libboost-dev libopenmpi-dev openmpi-bin
   libmatio-dev pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-matplotlib
 )
 

@@ -15,7 +15,8 @@ int blocks_command(std::ostream& out) {
       if (!p.unit.empty()) out << " " << p.unit;
       if (std::isfinite(p.lower) || std::isfinite(p.upper))
         out << "  in [" << p.lower << ", " << p.upper << "]";
-      out << "  " << p.description << (p.differentiable ? "" : " (not differentiable)") << "\n";
+      // A differentiable parameter can be a sensitivity direction by its path (block.name).
+      out << "  " << p.description << (p.differentiable ? "  [direction]" : "  (not differentiable: no direction)") << "\n";
     }
     for (const auto& s : t->settings)
       out << "    setting " << std::left << std::setw(12) << s.name

@@ -54,7 +54,20 @@ struct ReplayArgs {
   std::string format = "csv";     ///< csv | mat (also replay.mat) | rpc (also signals.rsp)
 };
 
+struct ScreenArgs {
+  std::string scene;
+  engine::SolverOverrides solver;  ///< --solver, --rtol, --atol, --step
+  std::string out = "out";
+  std::vector<std::string> sets;
+  std::vector<std::string> parameters;  ///< --params: scene parameters or declared directions
+  int samples = 16;
+  bool report = false;
+  bool resume = false;
+  int threads = 0;                ///< --threads: 0 one per core (one per rank under MPI)
+};
+
 int run_command(const RunArgs& args);
+int screen_command(const ScreenArgs& args);
 int replay_command(const ReplayArgs& args);
 int accuracy_command(const AccuracyArgs& args);
 int sweep_command(const SweepArgs& args);

@@ -5,9 +5,11 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
+#include <sstream>
 
 #include "apps/dydp/commands.hpp"
 #include "engine/errors.hpp"
+#include "engine/run_sharing.hpp"
 
 namespace {
 
@@ -23,6 +25,10 @@ void add_solver_options(CLI::App* command, dydp::engine::SolverOverrides& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Under mpirun: one process per rank; rank 0 alone prints and writes results.
+  const dydp::engine::RankSession ranks(&argc, &argv);
+  std::ostringstream quiet;
+  std::ostream& err = dydp::engine::world_rank() == 0 ? std::cerr : quiet;
   CLI::App app{"dydp: exact sensitivities of vehicle comfort and handling to design parameters"};
   app.require_subcommand(1);
 
@@ -77,30 +83,48 @@ int main(int argc, char** argv) {
                      "csv: the CSV/JSON files; mat: also replay.mat (MAT v5); rpc: also signals.rsp (RPC III)")
       ->check(CLI::IsMember({"csv", "mat", "rpc"}))->capture_default_str();
 
-  CLI::App* blocks = app.add_subcommand("blocks", "List the block types with ports and parameters");
+  dydp::apps::ScreenArgs screen_args;
+  CLI::App* screen = app.add_subcommand(
+      "screen", "Rank parameters over their ranges: Sobol' points, exact gradients, derivative-based global measures");
+  screen->add_option("scene", screen_args.scene, "scene file (YAML)")->required();
+  screen->add_option("--params", screen_args.parameters,
+                     "scene parameters or declared directions to screen, each with a range in the scene")
+      ->delimiter(',')->required();
+  screen->add_option("--samples", screen_args.samples, "Sobol' points (runs besides the nominal one)")->capture_default_str();
+  screen->add_option("--out", screen_args.out, "output folder (runs recorded in OUT/runs/)")->capture_default_str();
+  screen->add_option("--set", screen_args.sets, "override a scene parameter: NAME=VALUE");
+  screen->add_flag("--report", screen_args.report, "also write plots (gnuplot) and report.md");
+  screen->add_flag("--resume", screen_args.resume, "keep the runs recorded in OUT/runs/ and run only the missing ones");
+  screen->add_option("--threads", screen_args.threads, "runs at a time (0: one per core; one per rank under MPI)")
+      ->capture_default_str();
+  add_solver_options(screen, screen_args.solver);
+
+  CLI::App* blocks = app.add_subcommand("blocks", "List the block types with ports and parameters; [direction]: a parameter that can be a "
+      "sensitivity direction, written BLOCK.PARAMETER in a scene's sensitivities: list");
 
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
+    const int code = dydp::engine::world_rank() == 0 ? app.exit(e) : app.exit(e, quiet, quiet);
     return code == 0 ? 0 : 2;
   }
 
   try {
     if (*run) return dydp::apps::run_command(run_args);
     if (*sweep) return dydp::apps::sweep_command(sweep_args);
+    if (*screen) return dydp::apps::screen_command(screen_args);
     accuracy_args.methods_given = accuracy->count("--methods") > 0;
     if (*accuracy) return dydp::apps::accuracy_command(accuracy_args);
     if (*replay) return dydp::apps::replay_command(replay_args);
     if (*blocks) return dydp::apps::blocks_command(std::cout);
   } catch (const dydp::engine::InputError& e) {
-    std::cerr << e.what() << "\n";
+    err << e.what() << "\n";
     return 2;
   } catch (const dydp::engine::SolverError& e) {
-    std::cerr << "solver failure: " << e.what() << "\n";
+    err << "solver failure: " << e.what() << "\n";
     return 1;
   } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
+    err << "error: " << e.what() << "\n";
     return 1;
   }
   return 0;

@@ -6,6 +6,7 @@
 
 #include "engine/diagram.hpp"
 #include "engine/run.hpp"
+#include "engine/screen_study.hpp"
 #include "engine/sweep.hpp"
 
 namespace dydp::apps {
@@ -19,5 +20,9 @@ void write_report(const std::string& dir, const engine::Diagram& d, const engine
 /// the logged signals for several p.
 void write_sweep_report(const std::string& dir, const std::string& scene,
                         const engine::SweepResult& r, double delta);
+
+/// Writes DIR/report.md and DIR/plots/*.png for a screening study: per objective the ranking
+/// (table and tornado chart) and psi and d(psi)/dp_i against p_i over the samples.
+void write_screen_report(const std::string& dir, const std::string& scene, const engine::ScreenResult& r);
 
 }  // namespace dydp::apps

@@ -9,6 +9,7 @@
 #include "apps/dydp/report.hpp"
 #include "engine/errors.hpp"
 #include "engine/output_writer.hpp"
+#include "engine/run_sharing.hpp"
 #include "engine/sweep.hpp"
 #include "io/mat_outputs.hpp"
 
@@ -73,10 +74,12 @@ int sweep_command(const SweepArgs& args) {
   if (!(args.delta >= 0 && std::isfinite(args.delta)))
     throw engine::InputError("--delta", 0, engine::format_number(args.delta), "must be positive (0: no change column)");
   spec.keep_runs = args.report;
-  std::cerr << "sweep: " << spec.points << " runs of " << args.scene << " over " << spec.parameter
+  if (engine::world_rank() == 0)
+    std::cerr << "sweep: " << spec.points << " runs of " << args.scene << " over " << spec.parameter
             << " in [" << spec.low << ", " << spec.high << "]"
             << (spec.fd_steps.empty() ? "" : ", with central differences") << "\n";
   const engine::SweepResult r = engine::sweep(spec);
+  if (!r.complete) return 0;  // another rank writes the results
 
   std::filesystem::create_directories(args.out);
   const std::string csv = sweep_csv(r, args.delta);

@@ -429,6 +429,17 @@ TEST_F(Cli, BlocksListsEveryRegisteredType) {
     EXPECT_NE(r.out.find(name), std::string::npos) << name << " not listed";
 }
 
+TEST_F(Cli, BlocksMarksTheParametersThatCanBeDirections) {
+  const Result r = dydp("blocks");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string step = r.out.substr(r.out.find("\nsource.step "));
+  const std::string time = step.substr(step.find("    param   time"));
+  EXPECT_NE(time.substr(0, time.find('\n')).find("(not differentiable: no direction)"), std::string::npos) << time;
+  const std::string damper = r.out.substr(r.out.find("\ndamper.cdc "));
+  const std::string friction = damper.substr(damper.find("    param   friction "));
+  EXPECT_NE(friction.substr(0, friction.find('\n')).find("[direction]"), std::string::npos) << friction;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------- sweep and accuracy
