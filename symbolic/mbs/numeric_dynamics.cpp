@@ -277,15 +277,7 @@ NumericDynamics::HingeFrame NumericDynamics::hinge_frame(const Kinematics& k, co
 }
 
 NumericDynamics::Matrix NumericDynamics::angular_jacobian(const Kinematics& k, int body) const {
-  const int frame = model_.bodies[body].frame;
-  Matrix J = Matrix::Zero(3, n());
-  for (int j = 0; j < n(); ++j) {
-    const Joint& joint = model_.joints[j];
-    if (frame < 0 || !is_revolute(joint.type) || !is_ancestor(j, frame)) continue;
-    const M3 Rp = joint.parent >= 0 ? k.rotation[joint.parent] : M3::Identity();
-    J.col(j) = Rp * axis_of_joint(joint);
-  }
-  return J;
+  return frame_angular_jacobian(k, model_.bodies[body].frame);
 }
 
 int NumericDynamics::cut_frame(const Cut& c) const {

@@ -67,12 +67,13 @@ class NumericDynamics {
     std::array<V3, 2> normals;
   };
   HingeFrame hinge_frame(const Kinematics& k, const Cut& c) const;
+  // d(omega)/d(qd), 3 x n: of a body, and of a joint frame (-1: the ground, zero)
   Matrix angular_jacobian(const Kinematics& k, int body) const;
   // A cut's equations are written in the components of the nearest joint frame carrying both
   // its bodies (-1: the ground; always the ground for a ball cut keeping some components).
   int cut_frame(const Cut& c) const;
   M3 cut_rotation(const Kinematics& k, const Cut& c) const;
-  Matrix frame_angular_jacobian(const Kinematics& k, int frame) const;  // of a joint frame, 3 x n  // d(omega of body)/d(qd), 3 x n
+  Matrix frame_angular_jacobian(const Kinematics& k, int frame) const;
   V3 vec(const Vec3Value& v) const { return {value(v[0]), value(v[1]), value(v[2])}; }
   double value(const Value& v) const { return model_.value(v); }
   bool is_ancestor(int joint, int descendant) const;
