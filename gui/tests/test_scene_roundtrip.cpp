@@ -1,4 +1,5 @@
-// Every scene in scenarios/ opened in the GUI and saved again means the same to the engine;
+// Every scene in scenarios/ and scenarios/stress/ opened in the GUI and saved again means the same
+// to the engine (settings and nominal magnitudes included);
 // a hand-written scene using every key does too; and a second round-trip changes nothing.
 #include <QDir>
 #include <QTemporaryFile>
@@ -38,11 +39,17 @@ class SceneRoundTrip : public QObject {
  private slots:
   void every_scenario_keeps_its_meaning_data() {
     QTest::addColumn<QString>("path");
-    const QDir dir(DYDP_SCENARIOS_DIR);
-    const QStringList scenes = dir.entryList({"*.yaml"}, QDir::Files, QDir::Name);
-    QVERIFY(!scenes.isEmpty());
-    for (const QString& name : scenes)
-      if (!name.startsWith('.')) QTest::newRow(name.toUtf8().constData()) << dir.filePath(name);
+    // the shipped scenes and the stress scenes
+    for (const QString& folder : {QString(DYDP_SCENARIOS_DIR), QString(DYDP_SCENARIOS_DIR) + "/stress"}) {
+      const QDir dir(folder);
+      const QStringList scenes = dir.entryList({"*.yaml"}, QDir::Files, QDir::Name);
+      QVERIFY(!scenes.isEmpty());
+      for (const QString& name : scenes) {
+        if (name.startsWith('.')) continue;
+        const QString row = QDir(DYDP_SCENARIOS_DIR).relativeFilePath(dir.filePath(name));
+        QTest::newRow(row.toUtf8().constData()) << dir.filePath(name);
+      }
+    }
   }
 
   void every_scenario_keeps_its_meaning() {
