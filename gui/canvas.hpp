@@ -95,6 +95,10 @@ class Canvas : public QGraphicsView {
   PortItem* port_at(QPoint view_pos) const;
   void update_wires_of(const std::string& block);
   void commit_moves();
+  /// Removes every wire item from the scene (the document is untouched).
+  void clear_wires();
+  /// Removes every block and wire item: before another level is drawn.
+  void clear_items();
 
   SceneController* controller_;
   QGraphicsScene scene_;

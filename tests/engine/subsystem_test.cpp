@@ -17,7 +17,7 @@
 #include "engine/errors.hpp"
 #include "engine/run.hpp"
 #include "tests/engine/msd_closed_form.hpp"
-#include "tests/temp_folder_test.hpp"
+#include "tests/engine/scene_error_test.hpp"
 
 namespace dydp::engine {
 namespace {
@@ -42,35 +42,9 @@ connections:
   - force.y -> body.f
 )";
 
-class Subsystems : public test::TempFolderTest {
+class Subsystems : public test::SceneErrorTest {
  protected:
-  Subsystems() : TempFolderTest("dydp_subsystems_") {}
-
-  /// Writes `text` to dir/relative (folders created) and returns its path.
-  std::string put(const std::string& relative, const std::string& text) const {
-    fs::create_directories((dir_ / relative).parent_path());
-    return write(relative, text);
-  }
-
-  static InputError load_error(const std::string& path) {
-    try {
-      load_scene(path);
-    } catch (const InputError& e) {
-      return e;
-    }
-    ADD_FAILURE() << path << " loaded without an InputError";
-    return InputError("", -1, "", "no error");
-  }
-
-  static void expect_error(const InputError& e, const std::string& file, int line,
-                           const std::string& field, const std::string& phrase) {
-    EXPECT_EQ(e.file(), file) << e.what();
-    EXPECT_EQ(e.line(), line) << e.what();
-    EXPECT_EQ(e.field(), field) << e.what();
-    const std::string what = e.what();
-    EXPECT_NE(what.find(phrase), std::string::npos) << "'" << phrase << "' not in: " << what;
-    EXPECT_EQ(what.rfind(file + ":" + std::to_string(line) + ": ", 0), 0u) << what;
-  }
+  Subsystems() : SceneErrorTest("dydp_subsystems_") {}
 
   /// A scene around one instance `osc` of the oscillator in sub/oscillator.yaml.
   std::string scene_with(const std::string& instance, const std::string& oscillator = kOscillator,
