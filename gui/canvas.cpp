@@ -40,6 +40,8 @@ Canvas::Canvas(SceneController* controller, QWidget* parent)
   sync();
 }
 
+Canvas::~Canvas() { disconnect(&scene_, nullptr, this, nullptr); }
+
 BlockItem* Canvas::block_item(const std::string& name) const {
   const auto it = blocks_.find(name);
   return it == blocks_.end() ? nullptr : it->second;

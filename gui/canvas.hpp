@@ -20,6 +20,9 @@ class Canvas : public QGraphicsView {
 
  public:
   explicit Canvas(SceneController* controller, QWidget* parent = nullptr);
+  /// The scene member outlives this body: its selection changes while it deletes its items
+  /// must no longer reach the canvas (or, through selection_changed, the window being closed).
+  ~Canvas() override;
 
   /// What a drop of a palette entry at scene position pos does; returns the new block's name.
   QString drop_block(const QString& type, QPointF pos);
