@@ -83,6 +83,24 @@ outputs: [g.y]
   expect_error(load_error(path), path, 7, "src.u", "has no output port 'u'");
 }
 
+// Found by the scene fuzzer (docs/fuzzing.md): an end written "block." was taken for the
+// whole block and indexed the block's ports at -1 (UBSan: pointer overflow in GraphBuilder).
+TEST_F(SceneValidation, ConnectionEndWithoutPortName) {
+  for (const char* wire : {"src.y -> g.", "src. -> g.u", ".y -> g.u"}) {
+    const std::string path = write("s.yaml", std::string(R"(scene: t
+time: {stop: 1.0, output_step: 0.1}
+blocks:
+  src: {type: source.sine}
+  g: {type: math.gain}
+connections:
+  - src.y -> g.u
+  - )") + wire + R"(
+outputs: [g.y]
+)");
+    expect_error(load_error(path), path, 8, "connections", "both ends need block.port");
+  }
+}
+
 TEST_F(SceneValidation, UnknownOutputPortInOutputs) {
   const std::string path = write("s.yaml", R"(scene: t
 time: {stop: 1.0, output_step: 0.1}

@@ -224,6 +224,20 @@ TEST_F(Subsystems, ConnectionInsideTheSubsystemToAnUnknownPort) {
   expect_error(e, (dir_ / "sub/oscillator.yaml").string(), 14, "osc.body.g", "has no input port 'g'");
 }
 
+// An end without its port name inside the subsystem file, in a connection or in an output
+// port's mapping, is refused where it is written (the scene fuzzer found the connection case
+// in a scene: docs/fuzzing.md).
+TEST_F(Subsystems, PortWithoutItsNameInsideTheSubsystem) {
+  std::string wire = kOscillator;
+  wire.replace(wire.find("force.y -> body.f"), 17, "force.y -> body.");
+  expect_error(load_error(scene_with("osc: {type: subsystem.oscillator, mass: $mass}", wire)),
+               (dir_ / "sub/oscillator.yaml").string(), 14, "connections", "both ends need block.port, got 'force.y -> body.'");
+  std::string shown = kOscillator;
+  shown.replace(shown.find("position: body.x"), 16, "position: body.");
+  expect_error(load_error(scene_with("osc: {type: subsystem.oscillator, mass: $mass}", shown)),
+               (dir_ / "sub/oscillator.yaml").string(), 8, "outputs.position", "expected an internal 'block.port', got 'body.'");
+}
+
 TEST_F(Subsystems, UnknownSubsystemParameterInsideTheFile) {
   std::string osc = kOscillator;
   osc.replace(osc.find("c: $damping"), 11, "c: $dampin");
