@@ -43,6 +43,9 @@ void GraphBuilder::connect(const std::string& src_block, const std::string& src_
                            const std::string& dst_block, const std::string& dst_port, int line,
                            const std::string& file) {
   const std::string from = src_block + "." + src_port, to = dst_block + "." + dst_port;
+  // resolve() takes an empty port for the whole block (an output request): a wire needs two ports.
+  if (src_port.empty() || dst_port.empty())
+    throw InputError(file_or_scene(file), line, "connections", "both ends need block.port, got '" + from + " -> " + to + "'");
   Edge e{resolve(src_block, src_port, false, line, file), resolve(dst_block, dst_port, true, line, file),
          line, file_or_scene(file)};
   const int w_src = nodes_[e.src.node].block->outputs()[e.src.port].width;

@@ -149,7 +149,11 @@ void SceneFlattener::connect(Level& level, const YAML::Node& item) {
   if (arrow == std::string::npos)
     throw InputError(file, line, "connections", "expected 'block.port -> block.port', got '" + text + "'");
   const std::string from = trim(text.substr(0, arrow)), to = trim(text.substr(arrow + 2));
-  if (from.find('.') == std::string::npos || to.find('.') == std::string::npos)
+  const auto is_block_port = [](const std::string& end) {
+    const auto dot = end.find('.');
+    return dot != std::string::npos && dot > 0 && dot + 1 < end.size();
+  };
+  if (!is_block_port(from) || !is_block_port(to))
     throw InputError(file, line, "connections", "both ends need block.port, got '" + text + "'");
   const FlatPort src = source(level, from, file, line);
   std::vector<FlatPort> dsts;

@@ -40,6 +40,8 @@ Canvas::Canvas(SceneController* controller, QWidget* parent)
   sync();
 }
 
+Canvas::~Canvas() { disconnect(&scene_, nullptr, this, nullptr); }
+
 BlockItem* Canvas::block_item(const std::string& name) const {
   const auto it = blocks_.find(name);
   return it == blocks_.end() ? nullptr : it->second;
@@ -199,11 +201,7 @@ void Canvas::draw(const View& view) {
     if (item && !item->same_shape(b, ports)) {
       // Settings changed the ports: remake the item (wires are remade below anyway).
       reselect = item->isSelected();
-      for (WireItem* w : wires_) {
-        scene_.removeItem(w);
-        delete w;
-      }
-      wires_.clear();
+      clear_wires();
       scene_.removeItem(item);
       delete item;
       item = nullptr;
@@ -234,11 +232,7 @@ void Canvas::draw(const View& view) {
     it = blocks_.erase(it);
   }
   // Wires: always redrawn from the connections.
-  for (WireItem* w : wires_) {
-    scene_.removeItem(w);
-    delete w;
-  }
-  wires_.clear();
+  clear_wires();
   for (const DocConnection& c : view.connections) {
     BlockItem* from = block_item(c.from.block);
     BlockItem* to = block_item(c.to.block);
@@ -260,6 +254,23 @@ void Canvas::grow_scene_rect() {
   scene_.setSceneRect(items.isEmpty() ? QRectF(-mx, -my, 2 * mx, 2 * my) : items.adjusted(-mx, -my, mx, my));
 }
 
+void Canvas::clear_wires() {
+  for (WireItem* w : wires_) {
+    scene_.removeItem(w);
+    delete w;
+  }
+  wires_.clear();
+}
+
+void Canvas::clear_items() {
+  clear_wires();
+  for (auto& [name, item] : blocks_) {
+    scene_.removeItem(item);
+    delete item;
+  }
+  blocks_.clear();
+}
+
 bool Canvas::open_subsystem(const QString& block) {
   const QStringList before = level_;
   level_ << block;
@@ -268,16 +279,7 @@ bool Canvas::open_subsystem(const QString& block) {
     level_ = before;
     return false;
   }
-  for (auto& [name, item] : blocks_) {
-    scene_.removeItem(item);
-    delete item;
-  }
-  blocks_.clear();
-  for (WireItem* w : wires_) {
-    scene_.removeItem(w);
-    delete w;
-  }
-  wires_.clear();
+  clear_items();
   draw(view);
   emit level_changed(level_);
   emit message(tr("inside %1 (read only): Alt+Up or the breadcrumb goes back").arg(level_.join(" ▸ ")));
@@ -289,16 +291,7 @@ void Canvas::close_subsystem(int levels) {
   if (level_.isEmpty()) return;
   const QString left = level_.back();
   for (int i = 0; i < levels && !level_.isEmpty(); ++i) level_.removeLast();
-  for (auto& [name, item] : blocks_) {
-    scene_.removeItem(item);
-    delete item;
-  }
-  blocks_.clear();
-  for (WireItem* w : wires_) {
-    scene_.removeItem(w);
-    delete w;
-  }
-  wires_.clear();
+  clear_items();
   sync();
   emit level_changed(level_);
   emit message({});

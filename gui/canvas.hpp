@@ -20,6 +20,9 @@ class Canvas : public QGraphicsView {
 
  public:
   explicit Canvas(SceneController* controller, QWidget* parent = nullptr);
+  /// The scene member outlives this body: its selection changes while it deletes its items
+  /// must no longer reach the canvas (or, through selection_changed, the window being closed).
+  ~Canvas() override;
 
   /// What a drop of a palette entry at scene position pos does; returns the new block's name.
   QString drop_block(const QString& type, QPointF pos);
@@ -95,6 +98,10 @@ class Canvas : public QGraphicsView {
   PortItem* port_at(QPoint view_pos) const;
   void update_wires_of(const std::string& block);
   void commit_moves();
+  /// Removes every wire item from the scene (the document is untouched).
+  void clear_wires();
+  /// Removes every block and wire item: before another level is drawn.
+  void clear_items();
 
   SceneController* controller_;
   QGraphicsScene scene_;

@@ -454,7 +454,7 @@ QString SceneController::make_direction(const QString& block_q, const QString& k
   DocBlock* target = after.find_block(block);
   const SceneValue* v = target->find(key);
   std::string name;
-  if (v && !v->is_list && !v->items.empty() && v->items.front().size() > 1 && v->items.front()[0] == '$') {
+  if (v && !v->is_list && !v->is_map && !v->items.empty() && v->items.front().size() > 1 && v->items.front()[0] == '$') {
     // Already driven by a scene parameter: that one becomes the direction.
     name = v->items.front().substr(1);
     if (!after.find_parameter(name)) return tr("%1.%2: unknown scene parameter '$%3'").arg(block_q, key_q, q(name));

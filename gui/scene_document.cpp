@@ -15,15 +15,26 @@ std::string trim(const std::string& s) {
 
 SceneValue SceneValue::parse(const std::string& text) {
   const std::string t = trim(text);
-  if (t.size() < 2 || t.front() != '[' || t.back() != ']') return scalar(t);
+  const bool list = t.size() >= 2 && t.front() == '[' && t.back() == ']';
+  const bool map = t.size() >= 2 && t.front() == '{' && t.back() == '}';
+  if (!list && !map) return scalar(t);
   SceneValue v;
-  v.is_list = true;
+  v.is_list = list;
+  v.is_map = map;
   const std::string inner = t.substr(1, t.size() - 2);
   if (trim(inner).empty()) return v;
   size_t start = 0;
   while (true) {
     const size_t comma = inner.find(',', start);
-    v.items.push_back(trim(inner.substr(start, comma - start)));
+    const std::string item = trim(inner.substr(start, comma - start));
+    if (map) {
+      // "name: value"; an entry without a colon keeps its text as the name (the engine refuses it)
+      const size_t colon = item.find(':');
+      v.keys.push_back(trim(item.substr(0, colon)));
+      v.items.push_back(colon == std::string::npos ? "" : trim(item.substr(colon + 1)));
+    } else {
+      v.items.push_back(item);
+    }
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
@@ -31,6 +42,11 @@ SceneValue SceneValue::parse(const std::string& text) {
 }
 
 std::string SceneValue::text() const {
+  if (is_map) {
+    std::string s = "{";
+    for (size_t i = 0; i < items.size(); ++i) s += (i ? ", " : "") + keys[i] + ": " + items[i];
+    return s + "}";
+  }
   if (!is_list) return items.empty() ? "" : items.front();
   std::string s = "[";
   for (size_t i = 0; i < items.size(); ++i) s += (i ? ", " : "") + items[i];
@@ -62,7 +78,7 @@ const SceneValue* DocBlock::find(const std::string& key) const {
 
 void DocBlock::set(const std::string& key, const SceneValue& v) {
   auto it = std::find_if(values.begin(), values.end(), [&](const auto& kv) { return kv.first == key; });
-  const bool erase = !v.is_list && (v.items.empty() || v.items.front().empty());
+  const bool erase = !v.is_list && !v.is_map && (v.items.empty() || v.items.front().empty());
   if (erase) {
     if (it != values.end()) values.erase(it);
   } else if (it != values.end()) {

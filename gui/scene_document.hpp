@@ -10,15 +10,20 @@
 
 namespace dydp::gui {
 
-/// A value as written in a scene: one scalar, or a list of scalars (`window: [2.0, 10.0]`).
+/// A value as written in a scene: one scalar, a list of scalars (`window: [2.0, 10.0]`), or a
+/// mapping of names to scalars (a block's state nominal magnitudes, `nominal: {x: 0.01}`).
 struct SceneValue {
   std::vector<std::string> items;
   bool is_list = false;
+  /// A mapping: keys[i] names items[i].
+  std::vector<std::string> keys;
+  bool is_map = false;
 
-  static SceneValue scalar(std::string text) { return {{std::move(text)}, false}; }
-  /// "[a, b]" reads as a list, anything else as one scalar (surrounding blanks removed).
+  static SceneValue scalar(std::string text) { return {{std::move(text)}, false, {}, false}; }
+  /// "[a, b]" reads as a list, "{k: a, l: b}" as a mapping, anything else as one scalar
+  /// (surrounding blanks removed).
   static SceneValue parse(const std::string& text);
-  /// The inverse of parse: "1.5", "$mass", "[2.0, 10.0]".
+  /// The inverse of parse: "1.5", "$mass", "[2.0, 10.0]", "{x: 0.01}".
   std::string text() const;
   bool operator==(const SceneValue&) const = default;
 };

@@ -31,6 +31,15 @@ class Reader {
     return n.Scalar();
   }
   SceneValue value(const YAML::Node& n, const std::string& field) const {
+    if (n.IsMap()) {
+      SceneValue v;
+      v.is_map = true;
+      for (auto kv : n) {
+        v.keys.push_back(scalar(kv.first, field));
+        v.items.push_back(scalar(kv.second, field + "." + kv.first.Scalar()));
+      }
+      return v;
+    }
     if (n.IsSequence()) {
       SceneValue v;
       v.is_list = true;
@@ -124,6 +133,12 @@ std::string leading_comment(const std::string& text) {
 
 // Emits a scalar as written; text that YAML would read as something else is quoted by yaml-cpp.
 void emit_value(YAML::Emitter& e, const SceneValue& v) {
+  if (v.is_map) {
+    e << YAML::Flow << YAML::BeginMap;
+    for (size_t i = 0; i < v.items.size(); ++i) e << YAML::Key << v.keys[i] << YAML::Value << v.items[i];
+    e << YAML::EndMap;
+    return;
+  }
   if (!v.is_list) {
     e << (v.items.empty() ? std::string() : v.items.front());
     return;

@@ -6,6 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libsundials-dev libyaml-cpp-dev libcli11-dev
+  clang-14 libclang-rt-14-dev
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev
   gnuplot-nox liborocos-kdl-dev
   qt6-base-dev qt6-charts-dev libqt6opengl6-dev libgl-dev

@@ -1,6 +1,6 @@
 // The meaning of a loaded scene as text, for comparing two files that should say the same:
-// blocks (type, parameter values and $refs), connections, outputs, objectives, sensitivities,
-// scene parameters, time and solver. Layout and formatting do not enter.
+// blocks (type, parameter values and $refs, settings, nominal magnitudes), connections, outputs,
+// objectives, sensitivities, scene parameters, time and solver. Layout and formatting do not enter.
 #pragma once
 
 #include <cstdio>
@@ -23,7 +23,8 @@ inline std::string diagram_meaning(const engine::Diagram& d) {
   s << "scene " << d.scene_name << "\n";
   s << "time " << exact(d.time.start) << " " << exact(d.time.stop) << " " << exact(d.time.output_step) << "\n";
   s << "solver " << d.solver.method << " " << exact(d.solver.rtol) << " " << exact(d.solver.atol) << " "
-    << exact(d.solver.step) << " " << d.solver.max_steps << " " << d.solver.sens_error_test << "\n";
+    << exact(d.solver.step) << " " << d.solver.max_steps << " " << d.solver.sens_error_test << " "
+    << exact(d.solver.min_step) << " " << d.solver.nominal_scaling << "\n";
   for (const auto& p : d.parameters)
     s << "parameter " << p.name << " = " << exact(p.value) << " [" << p.unit << "] in [" << exact(p.lower)
       << ", " << exact(p.upper) << "]\n";
@@ -42,6 +43,16 @@ inline std::string diagram_meaning(const engine::Diagram& d) {
     }
     for (size_t k = 0; k < n.input_source.size(); ++k)
       s << "  " << port_at[n.input_source[k]] << " -> " << n.name << "." << n.block->inputs()[k].name << "\n";
+    // settings as written (objective windows, road class and seed, steering mode, input files,
+    // demux indices, ...) and the states' nominal magnitudes
+    for (const auto& spec : n.type->settings) {
+      s << "  setting " << spec.name << " =";
+      for (const auto& item : n.settings->texts(spec.name)) s << " " << item;
+      s << "\n";
+    }
+    s << "  nominal";
+    for (double v : n.state_nominal) s << " " << exact(v);
+    s << "\n";
     s << "  states " << n.block->num_states() << ", quadratures " << n.block->num_quadratures() << "\n";
   }
   for (const auto& p : d.pruned) s << "pruned " << p << "\n";

@@ -1,4 +1,5 @@
-// Every scene in scenarios/ opened in the GUI and saved again means the same to the engine;
+// Every scene in scenarios/ and scenarios/stress/ opened in the GUI and saved again means the same
+// to the engine (settings and nominal magnitudes included);
 // a hand-written scene using every key does too; and a second round-trip changes nothing.
 #include <QDir>
 #include <QTemporaryFile>
@@ -38,11 +39,17 @@ class SceneRoundTrip : public QObject {
  private slots:
   void every_scenario_keeps_its_meaning_data() {
     QTest::addColumn<QString>("path");
-    const QDir dir(DYDP_SCENARIOS_DIR);
-    const QStringList scenes = dir.entryList({"*.yaml"}, QDir::Files, QDir::Name);
-    QVERIFY(!scenes.isEmpty());
-    for (const QString& name : scenes)
-      if (!name.startsWith('.')) QTest::newRow(name.toUtf8().constData()) << dir.filePath(name);
+    // the shipped scenes and the stress scenes
+    for (const QString& folder : {QString(DYDP_SCENARIOS_DIR), QString(DYDP_SCENARIOS_DIR) + "/stress"}) {
+      const QDir dir(folder);
+      const QStringList scenes = dir.entryList({"*.yaml"}, QDir::Files, QDir::Name);
+      QVERIFY(!scenes.isEmpty());
+      for (const QString& name : scenes) {
+        if (name.startsWith('.')) continue;
+        const QString row = QDir(DYDP_SCENARIOS_DIR).relativeFilePath(dir.filePath(name));
+        QTest::newRow(row.toUtf8().constData()) << dir.filePath(name);
+      }
+    }
   }
 
   void every_scenario_keeps_its_meaning() {
@@ -109,6 +116,59 @@ outputs: [lag.y, sum, peak, energy]
     QVERIFY(text.find("description: forcing frequency") != std::string::npos);
     // Numbers keep the text they were written with.
     QVERIFY(text.find("rtol: 1.0e-5") != std::string::npos);
+  }
+
+  // Block settings of every kind (road class and seed, steering mode, input files and columns,
+  // demux indices, signs, objective windows), a state's nominal magnitude and every solver key,
+  // each on a block that feeds an output so that none is pruned before the comparison.
+  void hand_written_settings_and_nominals() {
+    QTemporaryDir dir;
+    QFile table(dir.filePath("bench.csv"));
+    QVERIFY(table.open(QIODevice::WriteOnly));
+    table.write("time,z,rack\n0.0,0.0,0.0\n1.0,0.01,0.002\n2.0,-0.01,0.004\n");
+    table.close();
+    const QString path = dir.filePath("settings.yaml");
+    QFile f(path);
+    QVERIFY(f.open(QIODevice::WriteOnly));
+    f.write(R"(scene: settings
+time: {start: 0.0, stop: 2.0, output_step: 0.01}
+solver: {method: bdf, rtol: 1.0e-6, atol: 1.0e-8, max_steps: 4000, sens_error_test: false, min_step: 1.0e-10, nominal_scaling: false}
+parameters:
+  tau: {value: 0.2, unit: s}
+sensitivities: [tau]
+blocks:
+  road:  {type: road.iso8608, speed: 15, class: D, seed: 7, components: 40, n_min: 0.02, n_max: 2.0}
+  pick:  {type: math.demux, width: 4, indices: [3, 1]}
+  split: {type: math.demux, width: 2, indices: [1]}
+  both:  {type: math.sum, signs: "-+"}
+  lag:   {type: math.lag, tau: $tau, nominal: {x: 0.01}}
+  table: {type: source.table, file: bench.csv, column: z, time_column: time}
+  sine:  {type: steering, mode: sine, amplitude: 0.005, frequency: 1.5, start: 0.2}
+  rack:  {type: steering, mode: csv, file: bench.csv, column: rack, time_column: time}
+  rms:   {type: objective.rms, window: [0.5, 2.0]}
+connections:
+  - road.z -> pick.u
+  - pick.y -> split.u
+  - split.y -> both.in1
+  - table.y -> both.in2
+  - both.y -> lag.u
+  - lag.y -> rms.in
+outputs: [lag.y, sine.rack, rack.rack, rms]
+)");
+    f.close();
+    const std::string original = diagram_meaning(dydp::engine::load_scene(path.toStdString()));
+    QVERIFY(original.find("pruned") == std::string::npos);
+    QVERIFY(original.find("setting class = D") != std::string::npos);
+    QVERIFY(original.find("setting indices = 3 1") != std::string::npos);
+    QVERIFY(original.find("nominal 0.01") != std::string::npos);
+    QVERIFY(original.find(" 1e-10 0\n") != std::string::npos);  // min_step, nominal_scaling off
+    SceneController c;
+    c.open(path);
+    std::string text;
+    bool same = false;
+    const std::string round = meaning_after_save(c, dir.path(), text, same);
+    QVERIFY2(same, "the saved file reopens as a different document");
+    QCOMPARE(QString::fromStdString(round), QString::fromStdString(original));
   }
 
   void hand_placed_layout_is_kept() {

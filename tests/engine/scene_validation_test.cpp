@@ -14,43 +14,16 @@
 
 #include "engine/diagram.hpp"
 #include "engine/errors.hpp"
-#include "tests/temp_folder_test.hpp"
+#include "tests/engine/scene_error_test.hpp"
 
 namespace dydp::engine {
 namespace {
 
 namespace fs = std::filesystem;
-using Overrides = std::vector<std::pair<std::string, std::string>>;
 
-class SceneValidation : public test::TempFolderTest {
+class SceneValidation : public test::SceneErrorTest {
  protected:
-  SceneValidation() : TempFolderTest("dydp_scene_validation_") {}
-
-  /// Loads the scene and returns the InputError it must raise (a failure when none is raised).
-  static InputError load_error(const std::string& path, const Overrides& overrides = {}) {
-    try {
-      load_scene(path, overrides);
-    } catch (const InputError& e) {
-      return e;
-    }
-    ADD_FAILURE() << path << " loaded without an InputError";
-    return InputError("", -1, "", "no error");
-  }
-
-  /// Asserts file, line, field and a key phrase of the message, and the "file:line:" prefix.
-  static void expect_error(const InputError& e, const std::string& file, int line,
-                           const std::string& field, const std::string& phrase) {
-    EXPECT_EQ(e.file(), file) << e.what();
-    EXPECT_EQ(e.line(), line) << e.what();
-    EXPECT_EQ(e.field(), field) << e.what();
-    const std::string what = e.what();
-    EXPECT_NE(what.find(phrase), std::string::npos) << "'" << phrase << "' not in: " << what;
-    const std::string prefix = line > 0 ? file + ":" + std::to_string(line) + ": " : file + ": ";
-    EXPECT_EQ(what.rfind(prefix, 0), 0u) << "expected prefix '" << prefix << "' in: " << what;
-    if (!field.empty()) {
-      EXPECT_NE(what.find(field + ": "), std::string::npos) << "field not in: " << what;
-    }
-  }
+  SceneValidation() : SceneErrorTest("dydp_scene_validation_") {}
 
   static int index_of(const Diagram& d, const std::string& name) {
     for (size_t i = 0; i < d.nodes.size(); ++i)
@@ -108,6 +81,24 @@ connections:
 outputs: [g.y]
 )");
   expect_error(load_error(path), path, 7, "src.u", "has no output port 'u'");
+}
+
+// Found by the scene fuzzer (docs/fuzzing.md): an end written "block." was taken for the
+// whole block and indexed the block's ports at -1 (UBSan: pointer overflow in GraphBuilder).
+TEST_F(SceneValidation, ConnectionEndWithoutPortName) {
+  for (const char* wire : {"src.y -> g.", "src. -> g.u", ".y -> g.u"}) {
+    const std::string path = write("s.yaml", std::string(R"(scene: t
+time: {stop: 1.0, output_step: 0.1}
+blocks:
+  src: {type: source.sine}
+  g: {type: math.gain}
+connections:
+  - src.y -> g.u
+  - )") + wire + R"(
+outputs: [g.y]
+)");
+    expect_error(load_error(path), path, 8, "connections", "both ends need block.port");
+  }
 }
 
 TEST_F(SceneValidation, UnknownOutputPortInOutputs) {

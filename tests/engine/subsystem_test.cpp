@@ -17,7 +17,7 @@
 #include "engine/errors.hpp"
 #include "engine/run.hpp"
 #include "tests/engine/msd_closed_form.hpp"
-#include "tests/temp_folder_test.hpp"
+#include "tests/engine/scene_error_test.hpp"
 
 namespace dydp::engine {
 namespace {
@@ -42,35 +42,9 @@ connections:
   - force.y -> body.f
 )";
 
-class Subsystems : public test::TempFolderTest {
+class Subsystems : public test::SceneErrorTest {
  protected:
-  Subsystems() : TempFolderTest("dydp_subsystems_") {}
-
-  /// Writes `text` to dir/relative (folders created) and returns its path.
-  std::string put(const std::string& relative, const std::string& text) const {
-    fs::create_directories((dir_ / relative).parent_path());
-    return write(relative, text);
-  }
-
-  static InputError load_error(const std::string& path) {
-    try {
-      load_scene(path);
-    } catch (const InputError& e) {
-      return e;
-    }
-    ADD_FAILURE() << path << " loaded without an InputError";
-    return InputError("", -1, "", "no error");
-  }
-
-  static void expect_error(const InputError& e, const std::string& file, int line,
-                           const std::string& field, const std::string& phrase) {
-    EXPECT_EQ(e.file(), file) << e.what();
-    EXPECT_EQ(e.line(), line) << e.what();
-    EXPECT_EQ(e.field(), field) << e.what();
-    const std::string what = e.what();
-    EXPECT_NE(what.find(phrase), std::string::npos) << "'" << phrase << "' not in: " << what;
-    EXPECT_EQ(what.rfind(file + ":" + std::to_string(line) + ": ", 0), 0u) << what;
-  }
+  Subsystems() : SceneErrorTest("dydp_subsystems_") {}
 
   /// A scene around one instance `osc` of the oscillator in sub/oscillator.yaml.
   std::string scene_with(const std::string& instance, const std::string& oscillator = kOscillator,
@@ -248,6 +222,20 @@ TEST_F(Subsystems, ConnectionInsideTheSubsystemToAnUnknownPort) {
   osc.replace(osc.find("force.y -> body.f"), 17, "force.y -> body.g");
   const auto e = load_error(scene_with("osc: {type: subsystem.oscillator, mass: $mass}", osc));
   expect_error(e, (dir_ / "sub/oscillator.yaml").string(), 14, "osc.body.g", "has no input port 'g'");
+}
+
+// An end without its port name inside the subsystem file, in a connection or in an output
+// port's mapping, is refused where it is written (the scene fuzzer found the connection case
+// in a scene: docs/fuzzing.md).
+TEST_F(Subsystems, PortWithoutItsNameInsideTheSubsystem) {
+  std::string wire = kOscillator;
+  wire.replace(wire.find("force.y -> body.f"), 17, "force.y -> body.");
+  expect_error(load_error(scene_with("osc: {type: subsystem.oscillator, mass: $mass}", wire)),
+               (dir_ / "sub/oscillator.yaml").string(), 14, "connections", "both ends need block.port, got 'force.y -> body.'");
+  std::string shown = kOscillator;
+  shown.replace(shown.find("position: body.x"), 16, "position: body.");
+  expect_error(load_error(scene_with("osc: {type: subsystem.oscillator, mass: $mass}", shown)),
+               (dir_ / "sub/oscillator.yaml").string(), 8, "outputs.position", "expected an internal 'block.port', got 'body.'");
 }
 
 TEST_F(Subsystems, UnknownSubsystemParameterInsideTheFile) {

@@ -1,5 +1,6 @@
 // A fuzz input as a file: the readers under test take paths. One file per process, rewritten
-// for every input, removed at exit.
+// for every input, removed at exit; by default in the system's temporary folder, or in a folder
+// the target prepared (so that relative paths in the input reach files next to it).
 #pragma once
 
 #include <unistd.h>
@@ -14,9 +15,9 @@ namespace dydp::fuzz {
 
 class InputFile {
  public:
-  explicit InputFile(const std::string& extension)
-      : path_((std::filesystem::temp_directory_path() /
-               ("dydp_fuzz_" + std::to_string(::getpid()) + extension)).string()) {}
+  explicit InputFile(const std::string& extension,
+                     const std::filesystem::path& folder = std::filesystem::temp_directory_path())
+      : path_((folder / ("dydp_fuzz_" + std::to_string(::getpid()) + extension)).string()) {}
   ~InputFile() { std::remove(path_.c_str()); }
 
   const std::string& write(const uint8_t* data, size_t size) {
