@@ -67,9 +67,12 @@ class SedanScenes : public ::testing::TestWithParam<std::pair<const char*, const
 
 TEST_P(SedanScenes, SameObjectivesAsTheFlatScene) {
   const auto [name, relative_path] = GetParam();
-  const Diagram flat = load_scene(flat_scene(name).string());
-  const Diagram built = load_scene(shipped_scene(relative_path).string());
+  Diagram flat = load_scene(flat_scene(name).string());
+  Diagram built = load_scene(shipped_scene(relative_path).string());
   expect_same_blocks(flat, built);
+  // The 4-poster's 20 s take ten minutes under the sanitizers: there, its first 4 s in both
+  // (the objectives' window [2, 20] then ends with the run, in both alike)
+  if (DYDP_SANITIZED && flat.time.stop > 10.0) flat.time.stop = built.time.stop = 4.0;
   const RunResult a = run(flat), b = run(built);
   ASSERT_EQ(a.objectives.size(), b.objectives.size());
   ASSERT_FALSE(a.objectives.empty());
