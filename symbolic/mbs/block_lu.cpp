@@ -50,7 +50,6 @@ void BlockLU::set_pattern(const Eigen::Matrix<char, Eigen::Dynamic, Eigen::Dynam
     b.lu.assign(k * k, 0.0);
     b.inverse.assign(k * k, 0.0);
     b.pivot.assign(k, 0);
-    b.perm.assign(k, 0);
   }
 }
 
@@ -80,25 +79,28 @@ bool BlockLU::factor(Block& b) {
   return regular;
 }
 
+void BlockLU::apply_factors(const Block& b, double* z) {
+  const int k = static_cast<int>(b.rows.size());
+  const double* __restrict a = b.lu.data();
+  for (int j = 0; j < k; ++j) std::swap(z[j], z[b.pivot[j]]);  // P b
+  for (int j = 0; j < k; ++j)                                   // L y = P b
+    for (int i = j + 1; i < k; ++i) z[i] -= a[j * k + i] * z[j];
+  for (int j = k - 1; j >= 0; --j) {                            // U x = y
+    z[j] /= a[j * k + j];
+    for (int i = 0; i < j; ++i) z[i] -= a[j * k + i] * z[j];
+  }
+}
+
 void BlockLU::invert() {
+  // The inverse (row-major), column by column of the identity through P, L and U: a block is
+  // solved for many right-hand sides per factorisation (the sedan: 14 columns of Ju, then the
+  // tangents' directions), k^2 independent multiply-adds each instead of two substitutions.
+  double* z = work_.data();
   for (Block& b : blocks_) {
     const int k = static_cast<int>(b.rows.size());
-    const double* a = b.lu.data();
-    // The inverse (row-major), column by column of the identity through P, L and U: a block is
-    // solved for many right-hand sides per factorisation (the sedan: 14 columns of Ju, then the
-    // tangents' directions), k^2 independent multiply-adds each instead of two substitutions.
-    int* perm = b.perm.data();
-    std::iota(perm, perm + k, 0);
-    for (int j = 0; j < k; ++j) std::swap(perm[j], perm[b.pivot[j]]);  // (P e)_i = e[perm[i]]
-    double* z = work_.data();
     for (int col = 0; col < k; ++col) {
-      for (int i = 0; i < k; ++i) z[i] = perm[i] == col ? 1.0 : 0.0;
-      for (int j = 0; j < k; ++j)
-        for (int i = j + 1; i < k; ++i) z[i] -= a[j * k + i] * z[j];
-      for (int j = k - 1; j >= 0; --j) {
-        z[j] /= a[j * k + j];
-        for (int i = 0; i < j; ++i) z[i] -= a[j * k + i] * z[j];
-      }
+      for (int i = 0; i < k; ++i) z[i] = i == col ? 1.0 : 0.0;
+      apply_factors(b, z);
       for (int i = 0; i < k; ++i) b.inverse[i * k + col] = z[i];
     }
   }
@@ -166,16 +168,9 @@ void BlockLU::substitute(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs,
     double* xc = x + c * ldx;
     for (const Block& b : blocks_) {
       const int k = static_cast<int>(b.rows.size());
-      const double* __restrict a = b.lu.data();
-      double* __restrict z = t + size_;
+      double* z = t + size_;
       for (int i = 0; i < k; ++i) z[i] = t[b.rows[i]];
-      for (int j = 0; j < k; ++j) std::swap(z[j], z[b.pivot[j]]);  // P b
-      for (int j = 0; j < k; ++j)                                   // L y = P b
-        for (int i = j + 1; i < k; ++i) z[i] -= a[j * k + i] * z[j];
-      for (int j = k - 1; j >= 0; --j) {                            // U x = y
-        z[j] /= a[j * k + j];
-        for (int i = 0; i < j; ++i) z[i] -= a[j * k + i] * z[j];
-      }
+      apply_factors(b, z);
       for (int i = 0; i < k; ++i) xc[b.cols[i]] = z[i];
     }
   }

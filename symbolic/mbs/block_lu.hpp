@@ -45,10 +45,11 @@ class BlockLU {
     std::vector<int> rows, cols;
     std::vector<double> lu;   // k x k, column-major: unit lower and upper factors of P A_block
     std::vector<int> pivot;   // row exchanged with row i at elimination step i
-    std::vector<int> perm;    // the exchanges as one permutation (invert's scratch)
     std::vector<double> inverse;  // k x k, row-major: block column c of x = sum over block rows
   };
   bool factor(Block& b);
+  // z := A_block^-1 z through the factors (the block's exchanges, then L and U)
+  static void apply_factors(const Block& b, double* z);
   void substitute(const double* b, Eigen::Index ldb, Eigen::Index nrhs, double* x, Eigen::Index ldx) const;
   bool inverted_ = false;
   std::vector<Block> blocks_;
