@@ -28,6 +28,11 @@ struct EmitOptions {
   bool extern_c = false;       // C linkage (for dlopen in tests)
   // Refuse to write more than this many operations (an in-extenso form can be astronomical).
   std::uint64_t max_ops = 20'000'000;
+  // When set, sines and cosines of the elements of the input array `trig_array` are read from
+  // the table this function returns ({sin x0, cos x0, sin x1, ...}, emit_trig_table), which a
+  // model's functions share, instead of each calling std::sin and std::cos.
+  std::string trig_table;
+  std::string trig_array = "q";
 };
 
 struct EmittedFunction {
@@ -42,6 +47,11 @@ EmittedFunction emit_function(const EquationList& list, const EmitOptions& optio
 // A tangent function; `tangent` comes from tangent_list(list, seeded_arrays) with the same arrays.
 EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayId> seeded_arrays,
                              const EmitOptions& options);
+
+// The table function of EmitOptions::trig_table for an array of `size` elements: sin and cos of
+// every element, computed again only when the array differs from the previous call's on the same
+// thread (all functions of a model called at one state share one evaluation).
+EmittedFunction emit_trig_table(std::size_t size, const EmitOptions& options);
 
 // Whole files: a header declaring the functions and a source including it (by `header_name`).
 std::string emit_header_file(std::span<const EmittedFunction> functions, const EmitOptions& options);

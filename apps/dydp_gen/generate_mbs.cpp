@@ -162,6 +162,9 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   // Four translation units, so that a large model's code compiles in parallel: dynamics (M and
   // the residual), its tangent, kinematics (constraints), sensors and Jacobians.
   std::vector<EmittedFunction> dynamics, residual_tangent, kinematics, sensors;
+  // sin and cos of the coordinates once per state, shared by every function below
+  emit.trig_table = name + "_trig";
+  dynamics.push_back(emit_trig_table(static_cast<std::size_t>(model.coordinates()), emit));
   dynamics.push_back(tangent(name + "_mass", *lists.inertial, {lists.qdd}, /*with_primal=*/false));
   dynamics.push_back(plain(name + "_residual", *lists.residual));
   if (lists.mass_matrix) dynamics.push_back(plain(name + "_mass_matrix", *lists.mass_matrix));

@@ -5,6 +5,7 @@
 // N_ext + sum (R_c n_c + r_c x R_c f_c), joint force Q_k = e . n_k (revolute) or e . f_k.
 #include "symbolic/mbs/newton_euler.hpp"
 
+#include <algorithm>
 #include <array>
 #include <functional>
 #include <map>
@@ -349,25 +350,57 @@ class Generator {
     // A force given in the components of joint frame `frame`, at a point: turned into the
     // point's body frame by the relative rotation when `frame` is an ancestor (for a spring
     // between chassis and wishbone, one joint's rotation) instead of through the ground.
+    // Forces are summed per point of application (the tyre's three components at its contact
+    // point, the cut forces at a ball joint) and their moment taken once (point_moments below).
+    std::map<std::pair<int, int>, V3> point_force;
     auto apply_in = [&](PointRef p, int frame, const V3& force) {
       if (p.body == 0) return;
       const V3 f = to_body(p.body, frame, force);
-      ext_f[p.body] = ext_f[p.body] + f;
-      ext_n[p.body] = ext_n[p.body] + cross(anchor(p), f);
+      const auto key = std::make_pair(p.body, p.anchor);
+      const auto it = point_force.find(key);
+      point_force[key] = it == point_force.end() ? f : it->second + f;
     };
     std::vector<Expr> joint_force(n, ctx_->zero());
     if (full) {
+      // Link forces between the same two points (a spring and a damper on one strut) act along
+      // the same line: their magnitudes are summed and the line's force applied once.
+      struct LinkGroup {
+        PointRef a, b;
+        int first_input;
+        Expr tension;  // positive pulls the points together
+      };
+      std::vector<LinkGroup> links;
+      {
+        int at = 0;
+        for (const Load& l : m_.loads) {
+          if (l.type != Load::Type::LinkForce) {
+            at += l.width();
+            continue;
+          }
+          const Expr magnitude = ctx_->element(out_.inp, at);
+          const Expr tension = l.compression ? -magnitude : magnitude;
+          auto same = [&](const LinkGroup& g) {
+            return g.a.body == l.point.body && g.a.anchor == l.point.anchor && g.b.body == l.b.body && g.b.anchor == l.b.anchor;
+          };
+          const auto it = std::find_if(links.begin(), links.end(), same);
+          if (it == links.end()) links.push_back({l.point, l.b, at, tension});
+          else it->tension = it->tension + tension;
+          ++at;
+        }
+      }
+      for (const LinkGroup& g : links) {
+        // in the frame of the two bodies' common ancestor: lengths do not depend on it
+        const int c = common_frame(m_.bodies[g.a.body].frame, m_.bodies[g.b.body].frame);
+        const V3 d = assign("DL", g.first_input, point_in(g.b, c) - point_in(g.a, c));
+        const Expr length = all_->assign("LL" + std::to_string(g.first_input + 1), symbolic::sqrt(dot(d, d)));
+        const V3 f = (-g.tension / length) * d;  // on b
+        apply_in(g.b, c, f);
+        apply_in(g.a, c, -f);
+      }
       int at = 0;
       for (const Load& l : m_.loads) {
         if (l.type == Load::Type::LinkForce) {
-          // in the frame of the two bodies' common ancestor: lengths do not depend on it
-          const int c = common_frame(m_.bodies[l.point.body].frame, m_.bodies[l.b.body].frame);
-          const V3 d = assign("DL", at, point_in(l.b, c) - point_in(l.point, c));
-          const Expr length = all_->assign("LL" + std::to_string(at + 1), symbolic::sqrt(dot(d, d)));
-          const Expr magnitude = ctx_->element(out_.inp, at++);
-          const V3 f = ((l.compression ? magnitude : -magnitude) / length) * d;  // on b
-          apply_in(l.b, c, f);
-          apply_in(l.point, c, -f);
+          ++at;
           continue;
         }
         V3 given = zero3();
@@ -424,6 +457,11 @@ class Generator {
         apply_in(e.a, c, f);
         apply_in(e.b, c, -f);
       }
+    }
+    for (const auto& [key, f] : point_force) {
+      const V3 sum = assign("FP" + tag + std::to_string(key.first) + "_", key.second, f);
+      ext_f[key.first] = ext_f[key.first] + sum;
+      ext_n[key.first] = ext_n[key.first] + cross(anchor(PointRef{key.first, key.second}), sum);
     }
 
     std::vector<V3> child_f(n, zero3()), child_n(n, zero3());
@@ -804,6 +842,49 @@ class Generator {
     return {rot.apply(v), rot.apply(a)};
   }
 
+  // Motion of joint frame k relative to its ancestor frame c, held fixed (c's own motion
+  // removed), in k's components: the forward recursion of velocities and accelerations started
+  // at rest at c, over the joints between them.
+  struct RelativeMotion {
+    V3 omega, velocity, alpha, acc;
+  };
+  RelativeMotion relative_motion(int k, int c) {
+    if (k == c) return {zero3(), zero3(), zero3(), zero3()};
+    const auto key = std::make_pair(k, c);
+    if (const auto it = relative_motion_.find(key); it != relative_motion_.end()) return it->second;
+    const Joint& j = m_.joints[k];
+    const RelativeMotion p = relative_motion(j.parent, c);
+    const V3 r = offset_[k], e = joint_axis(k);
+    const Expr qd = ctx_->element(out_.qd, k), qdd = ctx_->element(out_.qdd, k);
+    const V3 wp = rotate_back(k, p.omega);
+    V3 w = wp, v = rotate_back(k, p.velocity + cross(p.omega, r));
+    V3 al = rotate_back(k, p.alpha);
+    V3 a = rotate_back(k, p.acc + cross(p.alpha, r) + cross(p.omega, cross(p.omega, r)));
+    if (is_revolute(j.type)) {
+      w = w + qd * e;
+      al = al + qdd * e + cross(wp, qd * e);
+    } else {
+      v = v + qd * e;
+      a = a + qdd * e + 2.0 * qd * cross(wp, e);
+    }
+    const std::string tag = "R" + std::to_string(c + 1) + "_";
+    RelativeMotion m{assign("OM" + tag, k, w), assign("V" + tag, k, v), assign("OMP" + tag, k, al), assign("A" + tag, k, a)};
+    return relative_motion_[key] = m;
+  }
+  // A point's velocity and acceleration relative to frame c (an ancestor of its body's frame, or
+  // that frame), in c's components.
+  PointMotion relative_point_motion(PointRef p, int c) {
+    const int f = m_.bodies[p.body].frame;
+    if (f == c) return {zero3(), zero3()};
+    const RelativeMotion m = relative_motion(f, c);
+    const V3 r = anchor(p);
+    const V3 wr = cross(m.omega, r);
+    const V3 v = m.velocity + wr;
+    const V3 a = m.acc + cross(m.alpha, r) + cross(m.omega, wr);
+    const Rot rot = relative_placement(f, c).rot;
+    return {rot.apply(v), rot.apply(a)};
+  }
+
   // The second time derivative of every cut equation, J qdd + Jdot qd, from the full pass's
   // velocities and accelerations. A cut written in the components of a moving frame c (angular
   // velocity w, acceleration al, own components): with d = R_c^T (x_b - x_a),
@@ -815,6 +896,20 @@ class Generator {
       const Cut& c = m_.cuts[ci];
       const int frame = cut_frame(c);
       const std::string tag = std::to_string(ci + 1) + "_";
+      if (frame >= 0 && c.type != Cut::Type::Hinge) {
+        // d in the components of frame c depends on the joints between c and the two points
+        // only: its derivatives are the points' motion relative to c, held fixed.
+        const PointMotion b = relative_point_motion(c.b, frame), a = relative_point_motion(c.a, frame);
+        const V3 da = b.acceleration - a.acceleration;
+        if (c.type == Cut::Type::Distance) {
+          const V3 dv = assign("DCV" + tag, 0, b.velocity - a.velocity);
+          const Expr inverse_length = 1.0 / val(c.length);
+          rows.push_back(all_->assign("HA" + std::to_string(++row), (dot(dv, dv) + dot(cut_vector(ci), da)) * inverse_length));
+        } else {
+          for (int comp : c.components) rows.push_back(all_->assign("HA" + std::to_string(++row), da[comp]));
+        }
+        continue;
+      }
       const PointMotion b = point_motion(c.b, frame), a = point_motion(c.a, frame);
       const V3 dv = assign("DCV" + tag, 0, b.velocity - a.velocity);  // R_c^T dx'
       const V3 da = b.acceleration - a.acceleration;                   // R_c^T dx''
@@ -923,6 +1018,7 @@ class Generator {
   std::vector<Expr> cos_, sin_;
   std::vector<std::array<std::array<Expr, 3>, 3>> relative_rotation_;  // R of joints about arbitrary axes
   std::map<std::pair<int, int>, Placement> relative_;  // frame k relative to its ancestor c
+  std::map<std::pair<int, int>, RelativeMotion> relative_motion_;
   std::vector<V3> cut_vectors_;
   std::vector<Rot> rot_;
   std::vector<V3> origin_, offset_, omega_, velocity_, full_alpha_, full_acc_;
