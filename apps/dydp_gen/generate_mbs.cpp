@@ -166,7 +166,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   emit.trig_table = name + "_trig";
   dynamics.push_back(emit_trig_table(static_cast<std::size_t>(model.coordinates()), emit));
   dynamics.push_back(tangent(name + "_mass", *lists.inertial, {lists.qdd}, /*with_primal=*/false));
-  dynamics.push_back(plain(name + "_residual", *lists.residual));
+  dynamics.push_back(plain(name + "_residual", *lists.applied));
   if (lists.mass_matrix) dynamics.push_back(plain(name + "_mass_matrix", *lists.mass_matrix));
   residual_tangent.push_back(tangent(name + "_residual_tangent", *lists.residual, all_seeded));
   auto part = [&](const std::string& label, const EquationList& list, std::size_t from, std::size_t to) {
@@ -177,8 +177,9 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
     result.parts.push_back({label, list.size(), c.size(), count_ops(c)});
   };
   const std::size_t n = model.coordinates(), m = model.constraint_count();
-  part(name + "_residual.inverse_dynamics", *lists.residual, 0, n);
-  part(name + "_residual.constraint_accelerations", *lists.residual, n, n + m);
+  part(name + "_residual.inverse_dynamics", *lists.applied, 0, n);
+  part(name + "_residual.constraint_accelerations", *lists.applied, n, n + m);
+  part(name + "_residual_tangent.primal_with_cut_forces", *lists.residual, 0, n);
   kinematics.push_back(plain(name + "_constraints", *lists.constraints));
   kinematics.push_back(tangent(name + "_constraints_tangent", *lists.position_constraints, all_seeded));
   kinematics.push_back(tangent(name + "_velocity_constraints_tangent", *lists.velocity_constraints, all_seeded));

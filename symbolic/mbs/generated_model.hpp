@@ -44,7 +44,9 @@ struct GeneratedModel {
   int independent_count;
   const int* independent;  // coordinates u; the others (not driven) are dependent
   GeneratedMassTangent mass;                       // seeded on qdd: columns of M
-  GeneratedFunction residual;                      // M qdd + c - J^T lam (n), J qdd + Jdot qd (m)
+  GeneratedFunction residual;                      // M qdd + c (n), J qdd + Jdot qd (m); lam not read
+  // Seeded like every tangent, of M qdd + c - J^T lam (n) and J qdd + Jdot qd (m): the cut
+  // forces enter here only (the partitioning's tangent differentiates J^T lam at frozen lam).
   GeneratedTangent residual_tangent;
   GeneratedFunction constraints;                   // h (m), J (m x n row-major)
   GeneratedTangent velocity_constraints_tangent;   // h (m), J qd (m)

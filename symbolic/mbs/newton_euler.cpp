@@ -81,8 +81,9 @@ class Generator {
 
     // The inertial pass: M qdd.
     const std::vector<Expr> inertial = dynamics(qdd, /*full=*/false, "I");
-    // The full pass: M qdd + c - J^T lam.
+    // The full pass: M qdd + c - J^T lam; and without the cut forces, M qdd + c.
     const std::vector<Expr> residual = dynamics(qdd, /*full=*/true, "");
+    const std::vector<Expr> applied = dynamics(qdd, /*full=*/true, "V", /*cut_forces=*/false);
     const std::vector<Expr> h = constraint_values();
     const std::vector<Expr> sensors = sensor_values();
 
@@ -115,9 +116,14 @@ class Generator {
     }
     out_.assignments_built = all_->size();
     {
-      std::vector<Output> o = outputs("r", residual);
-      for (const Output& a : outputs("a", cut_accelerations())) o.push_back(a);
+      const std::vector<Output> accelerations = outputs("a", cut_accelerations());
+      std::vector<Output> o = outputs("r", residual), v = outputs("r", applied);
+      for (const Output& a : accelerations) {
+        o.push_back(a);
+        v.push_back(a);
+      }
       out_.residual = merged(o, {}, o);
+      out_.applied = merged(v, {}, v);
     }
     {
       std::vector<Output> o = outputs("h", h);
@@ -316,10 +322,20 @@ class Generator {
 
   // The Newton-Euler passes. `full`: gravity, velocities, loads, force elements and cut forces;
   // otherwise the inertial pass (M qdd). Returns the joint forces.
-  std::vector<Expr> dynamics(const std::vector<Expr>& qdd, bool full, const std::string& tag) {
+  // `cut_forces` false: without the cut forces J^T lam (the inverse dynamics proper, which the
+  // coordinate partitioning needs; the multipliers enter only its tangent). A second full pass
+  // reuses the first one's forward kinematics.
+  std::vector<Expr> dynamics(const std::vector<Expr>& qdd, bool full, const std::string& tag, bool cut_forces = true) {
     const int n = m_.coordinates();
     std::vector<V3> omega(n), alpha(n), acc(n);
+    const bool forward_known = full && !full_alpha_.empty();
+    if (forward_known) {
+      omega = omega_;
+      alpha = full_alpha_;
+      acc = full_acc_;
+    }
     for (const int k : m_.order) {
+      if (forward_known) break;
       const Joint& j = m_.joints[k];
       const V3 wp = j.parent >= 0 ? omega[j.parent] : zero3();
       const V3 ap = j.parent >= 0 ? alpha[j.parent] : zero3();
@@ -414,7 +430,7 @@ class Generator {
         }
       }
       int row = 0;
-      for (std::size_t ci = 0; ci < m_.cuts.size(); ++ci) {
+      for (std::size_t ci = 0; ci < m_.cuts.size() && cut_forces; ++ci) {
         const Cut& c = m_.cuts[ci];
         // ball and hinge rows are components in the cut's frame, and so is their force
         const int frame = cut_frame(c);

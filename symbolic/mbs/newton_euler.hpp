@@ -27,6 +27,9 @@ struct ModelLists {
   // r = M qdd + c - J^T lam (n outputs), then the constraint accelerations J qdd + Jdot qd (m),
   // the cut points' relative accelerations from the full pass (Jdot qd: the same at qdd = 0).
   std::unique_ptr<symbolic::EquationList> residual;
+  // The same without the cut forces (lam not read): M qdd + c (n), then J qdd + Jdot qd (m). The
+  // partitioning evaluates this one; the multipliers enter only through the residual's tangent.
+  std::unique_ptr<symbolic::EquationList> applied;
   // h (m), J (m x n, row-major).
   std::unique_ptr<symbolic::EquationList> constraints;
   // h (m), J qd (m): its tangent gives the dependent coordinates' and velocities' derivatives.

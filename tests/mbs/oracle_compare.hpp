@@ -55,4 +55,13 @@ inline Vector generated_outputs(GeneratedFunction f, int size, const Args& a) {
   return Eigen::Map<Vector>(out.data(), size);
 }
 
+// The primal outputs a tangent function writes (called with no direction): for the residual's
+// tangent, M qdd + c - J^T lam and J qdd + Jdot qd with the multipliers of `a`.
+inline Vector tangent_primal(GeneratedTangent f, int size, const Args& a) {
+  std::vector<double> out(std::max(size, 1)), unused(1, 0.0);
+  f(a.q.data(), a.qd.data(), a.qdd.data(), a.lam.data(), a.inp.data(), a.p.data(), 0, unused.data(), unused.data(),
+    unused.data(), unused.data(), unused.data(), out.data(), unused.data());
+  return Eigen::Map<Vector>(out.data(), size);
+}
+
 }  // namespace dydp::mbs::testing

@@ -69,7 +69,18 @@ TEST_P(Generated, EveryFunctionMatchesTheOracle) {
       EXPECT_GT(g.n, 100) << "only a deep tree keeps M as the inertial pass's tangent";
     }
     const Vector r = generated_outputs(g.residual, n + m, a);
-    EXPECT_LT(relative_error(r.head(n), oracle.residual(q, qd, qdd, lam, inp)), 1e-10) << "M qdd + c - J^T lam";
+    EXPECT_LT(relative_error(r.head(n), oracle.residual(q, qd, qdd, Vector::Zero(m), inp)), 1e-10)
+        << "M qdd + c (the residual reads no multipliers)";
+    const Vector with_cut_forces = tangent_primal(g.residual_tangent, n + m, a);
+    EXPECT_LT(relative_error(with_cut_forces.head(n), oracle.residual(q, qd, qdd, lam, inp)), 1e-10)
+        << "M qdd + c - J^T lam (the residual tangent's primal)";
+    if (m > 0) {
+      EXPECT_GT(relative_error(with_cut_forces.head(n), r.head(n)), 1e-6) << "the random multipliers load the joints";
+      Args unloaded = a;
+      unloaded.lam.setZero();
+      EXPECT_LT(relative_error(tangent_primal(g.residual_tangent, n + m, unloaded), r), 1e-12)
+          << "without multipliers the tangent's primal is the residual";
+    }
     Args at_rest = a;
     at_rest.qdd.setZero();
     at_rest.lam.setZero();

@@ -209,8 +209,13 @@ Reference position_constraints(const GeneratedModel& g) {
   return [&g](const Args& x) { return Vector(generated_outputs(g.constraints, g.m + g.m * g.n, x).head(g.m)); };
 }
 
+// M qdd + c - J^T lam, J qdd + Jdot qd with the cut forces applied at the cut points, as the
+// residual's tangent writes it (its primal outputs, checked against the oracle in
+// test_generated.cpp; the residual function itself reads no multipliers). Off the constraint
+// manifold (random states) the two forces of a ball cut are a couple d x f, which J^T lam has
+// not: the reference must be this form, not residual - J^T lam.
 Reference residual(const GeneratedModel& g) {
-  return [&g](const Args& x) { return generated_outputs(g.residual, g.n + g.m, x); };
+  return [&g](const Args& x) { return tangent_primal(g.residual_tangent, g.n + g.m, x); };
 }
 
 // At kStates random states: the tangent's `out` against the primal reference (to `same`,
