@@ -23,7 +23,7 @@ using nlohmann::ordered_json;
 
 std::string runs_folder(const std::string& out) { return out + "/runs"; }
 
-/// FNV-1a of the scene file's bytes: a record of another scene text is not resumed.
+/// FNV-1a of a file's bytes: a record of another scene (or subsystem) text is not resumed.
 std::string file_digest(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
@@ -47,6 +47,11 @@ ordered_json identity(const ScreenSpec& spec, const ScreenResult& r, const Diagr
   ordered_json j;
   j["scene"] = fs::absolute(spec.scene).lexically_normal().string();
   j["scene_digest"] = file_digest(spec.scene);
+  // the subsystem files the scene includes: an edited corner is another study too
+  std::set<std::string> included;
+  for (const Node& n : d.nodes)
+    if (!n.file.empty()) included.insert(fs::absolute(n.file).lexically_normal().string());
+  for (const std::string& file : included) j["subsystem_digests"][file] = file_digest(file);
   j["set"] = ordered_json::array();
   for (const auto& [name, value] : spec.overrides) j["set"].push_back(name + "=" + value);
   j["solver"] = {{"method", d.solver.method}, {"rtol", d.solver.rtol}, {"atol", d.solver.atol}, {"step", d.solver.step}};

@@ -114,6 +114,52 @@ TEST_F(Screen, AStudyKilledMidwayAndResumedGivesTheNumbersOfAnUninterruptedOne) 
   EXPECT_NE(other.err.find("study.json: set: the recorded study differs"), std::string::npos) << other.err;
 }
 
+TEST_F(Screen, RecordsOfAStudyWhoseSubsystemFileChangedAreNotResumed) {
+  // The oscillator of msd_sensitivity.yaml as a subsystem in a file of its own.
+  fs::create_directories(dir_ / "sub");
+  write("sub/oscillator.yaml", R"(subsystem: oscillator
+parameters:
+  stiffness: {value: 40.0, unit: N/m}
+  damping: {value: 1.2, unit: N s/m}
+outputs:
+  position: body.x
+blocks:
+  force: {type: source.sine, amplitude: 2.0, frequency: 0.8}
+  body: {type: mass_spring_damper, m: 1.5, k: $stiffness, c: $damping, x0: 0.05, v0: 0.1}
+connections:
+  - force.y -> body.f
+)");
+  const std::string scene = write("s.yaml", R"(scene: s
+time: {start: 0.0, stop: 4.0, output_step: 0.01}
+solver: {method: bdf, rtol: 1.0e-8, atol: 1.0e-10}
+parameters:
+  stiffness: {value: 40.0, unit: N/m, range: [30.0, 50.0]}
+  damping: {value: 1.2, unit: N s/m, range: [0.8, 1.6]}
+subsystems:
+  oscillator: {file: sub/oscillator.yaml}
+blocks:
+  osc: {type: subsystem.oscillator, stiffness: $stiffness, damping: $damping}
+  x_rms: {type: objective.rms, window: [1.0, 4.0]}
+connections:
+  - osc.position -> x_rms.in
+outputs: [x_rms]
+)");
+  const fs::path out = dir_ / "out";
+  const std::string args = quote(scene) + " --params stiffness,damping --samples 2 --out " + quote(out.string());
+  const ProcessResult first = dydp("screen " + args);
+  ASSERT_EQ(first.status, 0) << first.err;
+  // Unchanged, the study resumes from its records.
+  const ProcessResult same = dydp("screen " + args + " --resume");
+  ASSERT_EQ(same.status, 0) << same.err;
+  EXPECT_NE(same.err.find("3 runs taken from the records, 0 run now"), std::string::npos) << same.err;
+  // The subsystem's mass edited: its records belong to another study.
+  write("sub/oscillator.yaml", replaced(read_text(dir_ / "sub/oscillator.yaml"), "m: 1.5", "m: 1.6"));
+  const ProcessResult edited = dydp("screen " + args + " --resume");
+  EXPECT_EQ(edited.status, 2);
+  EXPECT_NE(edited.err.find("study.json: subsystem_digests: the recorded study differs"), std::string::npos)
+      << edited.err;
+}
+
 TEST_F(Screen, MeasuresFollowFromTheSamplesAndGradientsFromSingleRuns) {
   const fs::path out = dir_ / "out";
   const std::string scene = source_path("scenarios/msd_sensitivity.yaml").string();
