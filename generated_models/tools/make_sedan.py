@@ -58,7 +58,13 @@ def norm(a):
 
 
 def fmt(v):
-    return "[" + ", ".join(f"{x:.12g}" if abs(x) > 1e-12 else "0" for x in v) + "]"
+    """[x, y, z]; a component given as a string (a parameter, `$name` or `-$name`) is written as is."""
+    return "[" + ", ".join(x if isinstance(x, str) else f"{x:.12g}" if abs(x) > 1e-12 else "0" for x in v) + "]"
+
+
+def with_parameter(v, axis, name, sign=1):
+    """v with component `axis` replaced by the parameter `name` (negated for sign -1)."""
+    return tuple((("-" if sign < 0 else "") + "$" + name) if i == axis else x for i, x in enumerate(v))
 
 
 def side(points, origin, sign):
@@ -80,6 +86,17 @@ w("  chassis_ixx: 550.0         # [kg m^2] about the centre of mass")
 w("  chassis_iyy: 2400.0")
 w("  chassis_izz: 2650.0")
 w("  wheel_mass: 21.103         # [kg] spindle (1.103) with wheel and tyre (20)")
+# Suspension geometry kept as symbols (sensitivity directions of the multibody block). Moving a
+# mount point holds the spring's free length and the sensors' design lengths: the car settles at
+# the ride height the new geometry gives, and the motion ratio changes with the lever.
+STRUT_ARM_Y = front["strut_arm"][1] - front["lca_front"][1]
+SHOCK_ARM_X = rear["shock_arm"][0] - rear["tl_chassis"][0]
+SPRING_ARM_X = rear["spring_arm"][0] - rear["tl_chassis"][0]
+CHASSIS_COM_Z = 0.2
+w(f"  strut_arm_y_front: {STRUT_ARM_Y:.12g}   # [m] front strut's lower mount on the lower arm, outboard of its front pivot (mirrored right)")
+w(f"  shock_arm_x_rear: {SHOCK_ARM_X:.12g}  # [m] rear damper's lower mount on the trailing link, along x from its pivot (behind it)")
+w(f"  spring_arm_x_rear: {SPRING_ARM_X:.12g} # [m] rear spring's lower seat on the trailing link, along x from its pivot (behind it)")
+w(f"  chassis_com_height: {CHASSIS_COM_Z:.12g}  # [m] sprung mass's centre above the chassis frame (the cm sensor stays at 0.2)")
 w("bodies:")
 wheel_names = {"fl": "front left", "fr": "front right", "rl": "rear left", "rr": "rear right"}
 
@@ -97,7 +114,8 @@ for c, sign in (("fl", 1), ("fr", -1)):
     bodies.append(dict(name=f"lca_{c}", parent="chassis", offset=lo,
                        joints=[dict(name=f"lca_{c}", type="R", axis=sub(P["lca_front"], P["lca_rear"]))],
                        mass=1.611, com=sub(P["lca_cm"], lo), inertia=(0.0151, 0.0207, 0.0355),
-                       anchors={"ball": sub(P["lca_ball"], lo), "strut": sub(P["strut_arm"], lo),
+                       anchors={"ball": sub(P["lca_ball"], lo),
+                                "strut": with_parameter(sub(P["strut_arm"], lo), 1, "strut_arm_y_front", sign),
                                 "arb": sub(P["arb_arm"], lo)}))
     uo = P["uca_front"]
     bodies.append(dict(name=f"uca_{c}", parent="chassis", offset=uo,
@@ -138,8 +156,10 @@ for c, sign in (("rl", 1), ("rr", -1)):
     bodies.append(dict(name=f"trailing_{c}", parent="chassis", offset=to,
                        joints=[dict(name=f"trailing_{c}_pitch", type="Ry"), dict(name=f"trailing_{c}_yaw", type="Rz")],
                        mass=15.204, com=sub(P["tl_cm"], to), inertia=(0.0762, 0.527, 0.567),
-                       anchors={"upright": sub(P["tl_upright"], to), "shock": sub(P["shock_arm"], to),
-                                "spring": sub(P["spring_arm"], to), "arb": sub(P["arb_arm"], to)}))
+                       anchors={"upright": sub(P["tl_upright"], to),
+                                "shock": with_parameter(sub(P["shock_arm"], to), 0, "shock_arm_x_rear"),
+                                "spring": with_parameter(sub(P["spring_arm"], to), 0, "spring_arm_x_rear"),
+                                "arb": sub(P["arb_arm"], to)}))
     bodies.append(dict(name=f"wheel_{c}", parent=f"upright_{c}", offset=sub(P["spindle"], uo),
                        joints=[dict(name=f"spin_{c}", type="Ry")],
                        mass="wheel", inertia=(0.6, 1.0, 0.6), anchors={"centre": (0, 0, 0)}))
@@ -159,7 +179,7 @@ w("      - {name: yaw, type: Rz}")
 w(f"      - {{name: pitch, type: Ry, initial: {CHASSIS_PITCH0}}}")
 w("      - {name: roll, type: Rx}")
 w("    mass: $chassis_mass")
-w("    com: [0, 0, 0.2]")
+w("    com: [0, 0, $chassis_com_height]")
 w("    inertia: [$chassis_ixx, $chassis_iyy, $chassis_izz]")
 w("    anchors:")
 for k, v in chassis_anchors.items():

@@ -223,10 +223,12 @@ TEST_F(BlockDirections, ShippedSedanScenesDeclareTheirSuspensionDirectionsWithou
   };
   for (const Expected& x : {Expected{"fourposter_comfort.yaml",
                                      {{"piston_rebound_section", 4}, {"damper_friction", 4}, {"spring_front", 2},
-                                      {"spring_rear", 2}, {"tyre_stiffness", 4}, {"gas_precharge", 4}},
+                                      {"spring_rear", 2}, {"tyre_stiffness", 4}, {"gas_precharge", 4},
+                                      {"strut_mount_front", 1}, {"shock_mount_rear", 1}, {"com_height", 1}},
                                      "valve_current"},
                             Expected{"cornering_arb.yaml",
-                                     {{"valve_current", 4}, {"piston_check_section", 4}, {"arb_lever_front", 1}},
+                                     {{"valve_current", 4}, {"piston_check_section", 4}, {"arb_lever_front", 1},
+                                      {"spring_seat_rear", 1}, {"com_height", 1}},
                                      "arb_front"}}) {
     SCOPED_TRACE(x.scene);
     const Diagram d = load_scene(scenes + x.scene);
