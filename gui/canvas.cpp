@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <set>
 
+#include "gui/ports_in_use.hpp"
 #include "gui/subsystem_ports.hpp"
 
 namespace dydp::gui {
@@ -68,15 +69,6 @@ std::string summary_of(const SceneDocument& doc, const DocBlock& b) {
   return type ? type->summary : "unknown block type";
 }
 
-BlockPorts ports_in(const SceneDocument& doc, const DocBlock& bound) {
-  if (doc.subsystem_of(bound)) return instance_ports(doc, bound);
-  const engine::BlockType* type = engine::Registry::global().find(bound.type);
-  if (type) return ports_of(*type, bound);
-  BlockPorts none;
-  none.error = "unknown block type '" + bound.type + "'";
-  return none;
-}
-
 engine::PortDecl port_named(const std::vector<engine::PortDecl>& ports, const std::string& name) {
   for (const auto& p : ports)
     if (p.name == name) return p;
@@ -116,7 +108,7 @@ bool Canvas::make_view(View& v) const {
   for (const DocBlock& b : def->blocks) {
     v.blocks.push_back(b);  // shown as written inside: `$stiffness`, not the instance's value
     const DocBlock bound = bound_block(*def, instance, b);
-    v.ports[b.name] = ports_in(doc, bound);
+    v.ports[b.name] = block_ports(doc, bound);
     v.summaries[b.name] = summary_of(doc, bound);
     left = first ? b.x : std::min(left, b.x);
     right = first ? b.x : std::max(right, b.x);
@@ -171,20 +163,8 @@ void Canvas::toggle_all_ports(const QString& block) {
 
 BlockPorts Canvas::shown_ports(const View& view, const std::string& block) const {
   // A block with very many ports (a whole car) shows those in use; the rest on request.
-  BlockPorts ports = view.ports.at(block);
-  if (ports.inputs.size() + ports.outputs.size() <= kPortsShownAll || all_ports_.count(block)) return ports;
-  std::set<std::string> used_in, used_out;
-  for (const DocConnection& c : view.connections) {
-    if (c.to.block == block) used_in.insert(c.to.port);
-    if (c.from.block == block) used_out.insert(c.from.port);
-  }
-  for (const std::string& o : view.outputs) {
-    PortRef r;
-    if (PortRef::parse(o, r) && r.block == block) used_out.insert(r.port);
-  }
-  std::erase_if(ports.inputs, [&](const engine::PortDecl& p) { return !used_in.count(p.name); });
-  std::erase_if(ports.outputs, [&](const engine::PortDecl& p) { return !used_out.count(p.name); });
-  return ports;
+  const BlockPorts& ports = view.ports.at(block);
+  return all_ports_.count(block) ? ports : ports_in_use(ports, block, view.connections, view.outputs);
 }
 
 void Canvas::draw(const View& view) {

@@ -55,9 +55,8 @@ class Canvas : public QGraphicsView {
   void close_subsystem(int levels = 1);
   /// The instances opened, outermost first; empty at the scene's level.
   const QStringList& level() const { return level_; }
-  /// A block with more than kPortsShownAll ports shows only those wired or logged, unless
-  /// toggled to show all (View > Show all ports).
-  static constexpr size_t kPortsShownAll = 30;
+  /// A block with more than kPortsShownAll ports (ports_in_use.hpp) shows only those wired or
+  /// logged, unless toggled to show all (View > Show all ports).
   void toggle_all_ports(const QString& block);
   /// Whether the level shown is the scene's own (editable) one.
   bool at_scene_level() const { return level_.isEmpty(); }

@@ -76,6 +76,11 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   edit->addAction(redo);
   auto* act_delete = edit->addAction(tr("&Delete"), this, [this] { canvas_->delete_selection(); });
   edit->addAction(tr("&Fit diagram"), this, [this] { canvas_->fit_all(); });
+  edit->addAction(tr("&Lay out diagram"), QKeySequence(Qt::CTRL | Qt::Key_L), this, [this] {
+    if (!canvas_->at_scene_level()) return status(tr("Lay out works on the scene's level: go back up first"));
+    controller_.lay_out();
+    canvas_->fit_all();
+  });
   auto* view = menuBar()->addMenu(tr("&View"));
   view->addAction(tr("&Open subsystem"), QKeySequence(Qt::ALT | Qt::Key_Down), this, [this] {
     const QStringList sel = canvas_->selected_blocks();

@@ -1,5 +1,6 @@
 #include "gui/scene_controller.hpp"
 
+#include "gui/automatic_layout.hpp"
 #include "gui/subsystem_ports.hpp"
 
 #include <QDir>
@@ -64,8 +65,8 @@ void SceneController::new_scene() {
 
 void SceneController::open(const QString& path) {
   SceneDocument doc = read_scene_file(s(path));
-  place_unplaced_blocks(doc);
-  for (DocSubsystem& def : doc.subsystems) place_unplaced_blocks(def.blocks, def.connections);
+  lay_out_scene(doc, LayoutScope::unplaced_blocks);
+  for (DocSubsystem& def : doc.subsystems) lay_out_definition(doc, def, LayoutScope::unplaced_blocks);
   undo_.clear();
   path_ = path;
   replace(doc);
@@ -111,37 +112,10 @@ BlockPorts SceneController::ports(const std::string& block) const {
   return it->second;
 }
 
-void SceneController::place_unplaced_blocks(SceneDocument& doc) const {
-  place_unplaced_blocks(doc.blocks, doc.connections);
-}
-
-void SceneController::place_unplaced_blocks(std::vector<DocBlock>& blocks,
-                                            const std::vector<DocConnection>& connections) const {
-  // Columns by signal flow: a block sits one column right of the furthest block driving it
-  // (longest path from the sources; cycles stop growing after as many rounds as blocks).
-  std::map<std::string, int> column;
-  for (const auto& b : blocks) column[b.name] = 0;
-  for (size_t round = 0; round < blocks.size(); ++round) {
-    bool changed = false;
-    for (const auto& c : connections) {
-      if (!column.count(c.from.block) || !column.count(c.to.block) || c.from.block == c.to.block) continue;
-      const int want = column[c.from.block] + 1;
-      if (column[c.to.block] < want && want < static_cast<int>(blocks.size())) {
-        column[c.to.block] = want;
-        changed = true;
-      }
-    }
-    if (!changed) break;
-  }
-  std::map<int, int> rows;
-  for (auto& b : blocks) {
-    const int col = column[b.name];
-    const int row = rows[col]++;
-    if (b.placed) continue;
-    b.x = 40 + 260 * col;
-    b.y = 40 + 170 * row;
-    b.placed = true;
-  }
+void SceneController::lay_out() {
+  SceneDocument after = doc_;
+  lay_out_scene(after, LayoutScope::all_blocks);
+  commit(tr("Lay out diagram"), std::move(after));
 }
 
 QString SceneController::add_block(const QString& type_name, QPointF pos) {
