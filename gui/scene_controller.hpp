@@ -44,6 +44,18 @@ class SceneController : public QObject {
   void move_block(const QString& name, QPointF pos);
   /// Places every block of the scene anew by the layered layout (one undo step).
   void lay_out();
+  /// Replaces the blocks by one instance of a new inline subsystem definition (subsystem_grouping.hpp);
+  /// `instance` receives its name.
+  QString group_into_subsystem(const QStringList& blocks, QString* instance = nullptr);
+
+  // Edits inside a subsystem definition written inline in the scene (one written in a file of
+  // its own is read only here: other scenes include it too).
+  /// Whether the definition named `subsystem` can be edited here.
+  bool definition_editable(const QString& subsystem) const;
+  void move_block_in(const QString& subsystem, const QString& block, QPointF pos);
+  /// A parameter or setting of a block inside: a number, `$name` of the definition's own
+  /// parameters, or a setting; checked as set_block_value checks the scene's blocks.
+  QString set_block_value_in(const QString& subsystem, const QString& block, const QString& key, const QString& text);
   QString connect_ports(const QString& from, const QString& to);
   /// Why `from -> to` cannot be wired ("" when it can); changes nothing.
   QString check_connection(const QString& from, const QString& to) const;
