@@ -43,10 +43,11 @@ bool may_name_block(const std::string& path, const std::string& block) {
   return literal.compare(0, n, head, 0, n) == 0;
 }
 
-/// A port name not yet in `used`: `wanted`, else `block_port`, else numbered.
+/// A port name not yet in `used`: the internal port's (`stroke_rate`), else `block_port` (also
+/// for names too short to say anything, such as a gain's `u` and `y`), else numbered.
 std::string port_name(const PortRef& inside, std::set<std::string>& used) {
   std::string name = inside.port;
-  if (used.count(name)) name = inside.block + "_" + inside.port;
+  if (used.count(name) || name.size() <= 2) name = inside.block + "_" + inside.port;
   const std::string stem = name;
   for (int k = 2; used.count(name); ++k) name = stem + std::to_string(k);
   used.insert(name);

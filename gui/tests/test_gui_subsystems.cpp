@@ -69,7 +69,7 @@ class GuiSubsystems : public QObject {
 
  private slots:
   // msd_sensitivity: the force and the body selected with the mouse (click, Ctrl+click) and
-  // grouped by Ctrl+G. The wire body.x -> x_rms.in crosses out: an output port; force -> body
+  // grouped by Ctrl+G. The wire body.x -> x_rms.in crosses out: output port body_x; force -> body
   // stays inside; $mass, $stiffness, $damping become the definition's parameters.
   void group_selection_with_the_mouse_save_and_run() {
     const std::string scene = std::string(DYDP_SCENARIOS_DIR) + "/msd_sensitivity.yaml";
@@ -103,11 +103,11 @@ class GuiSubsystems : public QObject {
     QCOMPARE(def->outputs.size(), size_t{1});
     QCOMPARE(QString::fromStdString(def->outputs.front().second), QString("body.x"));
     QCOMPARE(doc.connections.size(), size_t{1});
-    QCOMPARE(QString::fromStdString(doc.connections.front().text()), QString("group.x -> x_rms.in"));
+    QCOMPARE(QString::fromStdString(doc.connections.front().text()), QString("group.body_x -> x_rms.in"));
     // Logged signals of the blocks inside are logged through the instance.
     QVERIFY(std::find(doc.outputs.begin(), doc.outputs.end(), "group.body.x") != doc.outputs.end());
     QCOMPARE(canvas->selected_blocks(), QStringList{"group"});
-    QVERIFY(canvas->block_item("group")->port("x", false));
+    QVERIFY(canvas->block_item("group")->port("body_x", false));
 
     QVERIFY(w.save_file(saved));
     const QString faults = compare_objectives(objectives_of(scene), objectives_of(saved.toStdString()), "group.", 1e-12);
