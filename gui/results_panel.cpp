@@ -21,7 +21,7 @@ QString q(const std::string& s) { return QString::fromStdString(s); }
 QChartView* make_chart_view() {
   auto* view = new QChartView(new QChart);
   view->setRenderHint(QPainter::Antialiasing);
-  view->chart()->legend()->setAlignment(Qt::AlignRight);
+  view->chart()->legend()->setAlignment(Qt::AlignBottom);
   view->chart()->setMargins(QMargins(4, 4, 4, 4));
   view->setMinimumHeight(140);
   return view;
