@@ -1,13 +1,16 @@
 #include "gui/canvas.hpp"
 
 #include <QDragEnterEvent>
+#include <QContextMenuEvent>
 #include <QKeyEvent>
+#include <QMenu>
 #include <QMimeData>
 #include <QScrollBar>
 #include <QWheelEvent>
 #include <algorithm>
 #include <set>
 
+#include "gui/ports_in_use.hpp"
 #include "gui/subsystem_ports.hpp"
 
 namespace dydp::gui {
@@ -33,9 +36,12 @@ Canvas::Canvas(SceneController* controller, QWidget* parent)
     shown_file_ = controller_->file_path();
   });
   connect(&scene_, &QGraphicsScene::selectionChanged, this, [this] {
-    if (!at_scene_level()) return;  // inside a subsystem: no block of the scene is selected
+    // Inside a subsystem written in a file of its own nothing is edited: nothing to show.
+    if (!level_editable()) return;
     const QStringList sel = selected_blocks();
-    emit selection_changed(sel.size() == 1 ? sel.front() : QString());
+    const DocSubsystem* def = definition_shown();
+    const bool block = sel.size() == 1 && (!def || def->find_block(sel.front().toStdString()));
+    emit selection_changed(block ? sel.front() : QString());
   });
   sync();
 }
@@ -68,15 +74,6 @@ std::string summary_of(const SceneDocument& doc, const DocBlock& b) {
   return type ? type->summary : "unknown block type";
 }
 
-BlockPorts ports_in(const SceneDocument& doc, const DocBlock& bound) {
-  if (doc.subsystem_of(bound)) return instance_ports(doc, bound);
-  const engine::BlockType* type = engine::Registry::global().find(bound.type);
-  if (type) return ports_of(*type, bound);
-  BlockPorts none;
-  none.error = "unknown block type '" + bound.type + "'";
-  return none;
-}
-
 engine::PortDecl port_named(const std::vector<engine::PortDecl>& ports, const std::string& name) {
   for (const auto& p : ports)
     if (p.name == name) return p;
@@ -86,6 +83,34 @@ engine::PortDecl port_named(const std::vector<engine::PortDecl>& ports, const st
 }
 
 }  // namespace
+
+const DocSubsystem* Canvas::definition_shown(DocBlock* instance_out) const {
+  if (level_.isEmpty()) return nullptr;
+  // Walk down the instances opened: each with its values bound as the engine binds them.
+  const SceneDocument& doc = controller_->document();
+  const DocBlock* top = doc.find_block(level_.front().toStdString());
+  if (!top) return nullptr;
+  DocBlock instance = *top;
+  const DocSubsystem* def = doc.subsystem_of(instance);
+  for (qsizetype i = 1; def && def->error.empty() && i < level_.size(); ++i) {
+    const DocBlock* inner = def->find_block(level_[i].toStdString());
+    if (!inner) return nullptr;
+    instance = bound_block(*def, instance, *inner);
+    def = doc.subsystem_of(instance);
+  }
+  if (!def || !def->error.empty()) return nullptr;
+  if (instance_out) *instance_out = instance;
+  return def;
+}
+
+QString Canvas::definition_name() const {
+  const DocSubsystem* def = definition_shown();
+  return def ? q(def->name) : QString();
+}
+
+bool Canvas::level_editable() const {
+  return at_scene_level() || controller_->definition_editable(definition_name());
+}
 
 bool Canvas::make_view(View& v) const {
   const SceneDocument& doc = controller_->document();
@@ -99,24 +124,15 @@ bool Canvas::make_view(View& v) const {
     }
     return true;
   }
-  // Walk down the instances opened: each with its values bound as the engine binds them.
-  const DocBlock* top = doc.find_block(level_.front().toStdString());
-  if (!top) return false;
-  DocBlock instance = *top;
-  const DocSubsystem* def = doc.subsystem_of(instance);
-  for (qsizetype i = 1; def && def->error.empty() && i < level_.size(); ++i) {
-    const DocBlock* inner = def->find_block(level_[i].toStdString());
-    if (!inner) return false;
-    instance = bound_block(*def, instance, *inner);
-    def = doc.subsystem_of(instance);
-  }
-  if (!def || !def->error.empty()) return false;
+  DocBlock instance;
+  const DocSubsystem* def = definition_shown(&instance);
+  if (!def) return false;
   double left = 0, right = 0, topmost = 0;
   bool first = true;
   for (const DocBlock& b : def->blocks) {
     v.blocks.push_back(b);  // shown as written inside: `$stiffness`, not the instance's value
     const DocBlock bound = bound_block(*def, instance, b);
-    v.ports[b.name] = ports_in(doc, bound);
+    v.ports[b.name] = block_ports(doc, bound);
     v.summaries[b.name] = summary_of(doc, bound);
     left = first ? b.x : std::min(left, b.x);
     right = first ? b.x : std::max(right, b.x);
@@ -171,24 +187,14 @@ void Canvas::toggle_all_ports(const QString& block) {
 
 BlockPorts Canvas::shown_ports(const View& view, const std::string& block) const {
   // A block with very many ports (a whole car) shows those in use; the rest on request.
-  BlockPorts ports = view.ports.at(block);
-  if (ports.inputs.size() + ports.outputs.size() <= kPortsShownAll || all_ports_.count(block)) return ports;
-  std::set<std::string> used_in, used_out;
-  for (const DocConnection& c : view.connections) {
-    if (c.to.block == block) used_in.insert(c.to.port);
-    if (c.from.block == block) used_out.insert(c.from.port);
-  }
-  for (const std::string& o : view.outputs) {
-    PortRef r;
-    if (PortRef::parse(o, r) && r.block == block) used_out.insert(r.port);
-  }
-  std::erase_if(ports.inputs, [&](const engine::PortDecl& p) { return !used_in.count(p.name); });
-  std::erase_if(ports.outputs, [&](const engine::PortDecl& p) { return !used_out.count(p.name); });
-  return ports;
+  const BlockPorts& ports = view.ports.at(block);
+  return all_ports_.count(block) ? ports : ports_in_use(ports, block, view.connections, view.outputs);
 }
 
 void Canvas::draw(const View& view) {
-  const bool editable = level_.isEmpty();
+  // At a subsystem's level the blocks inside move, the port blocks at the edges do not.
+  const DocSubsystem* def = definition_shown();
+  const bool editable = level_editable();
   // Blocks: keep items whose shape is unchanged (selection and error marks survive), remake others.
   std::set<std::string> present;
   for (const DocBlock& b : view.blocks) {
@@ -218,7 +224,7 @@ void Canvas::draw(const View& view) {
       blocks_[b.name] = item;
       item->setSelected(reselect);
     }
-    item->setFlag(QGraphicsItem::ItemIsMovable, editable);
+    item->setFlag(QGraphicsItem::ItemIsMovable, editable && (!def || def->find_block(b.name)));
     if (item->pos() != QPointF(b.x, b.y)) item->setPos(b.x, b.y);
     item->set_logged(view.outputs);
   }
@@ -282,7 +288,11 @@ bool Canvas::open_subsystem(const QString& block) {
   clear_items();
   draw(view);
   emit level_changed(level_);
-  emit message(tr("inside %1 (read only): Alt+Up or the breadcrumb goes back").arg(level_.join(" ▸ ")));
+  emit message(level_editable()
+                   ? tr("inside %1: blocks move and their values are edited in the Block tab; Alt+Up or the breadcrumb goes back")
+                         .arg(level_.join(" ▸ "))
+                   : tr("inside %1 (read only: defined in %2); Alt+Up or the breadcrumb goes back")
+                         .arg(level_.join(" ▸ "), q(definition_shown()->file)));
   fit_all();
   return true;
 }
@@ -497,16 +507,55 @@ void Canvas::mouseReleaseEvent(QMouseEvent* e) {
 }
 
 void Canvas::commit_moves() {
-  if (!at_scene_level()) return;
+  if (!level_editable()) return;
   // Blocks dragged with the mouse: one undo step for all that moved.
+  const DocSubsystem* def = definition_shown();
+  const QString inside = def ? q(def->name) : QString();
   std::vector<std::pair<QString, QPointF>> moved;
-  for (const DocBlock& b : controller_->document().blocks)
+  for (const DocBlock& b : def ? def->blocks : controller_->document().blocks)
     if (BlockItem* item = block_item(b.name); item && item->pos() != QPointF(b.x, b.y))
       moved.emplace_back(q(b.name), item->pos());
   if (moved.empty()) return;
   controller_->undo_stack()->beginMacro(tr("Move"));
-  for (const auto& [name, pos] : moved) controller_->move_block(name, pos);
+  for (const auto& [name, pos] : moved) {
+    if (inside.isEmpty()) controller_->move_block(name, pos);
+    else controller_->move_block_in(inside, name, pos);
+  }
   controller_->undo_stack()->endMacro();
+}
+
+QString Canvas::group_selection() {
+  if (!at_scene_level()) {
+    emit message(tr("refused: group blocks at the scene's level"));
+    return tr("not at the scene's level");
+  }
+  QString instance;
+  const QString why = controller_->group_into_subsystem(selected_blocks(), &instance);
+  if (!why.isEmpty()) {
+    emit message(tr("refused: %1").arg(why));
+    return why;
+  }
+  select_block(instance);
+  emit message(tr("grouped into subsystem %1: double-click it to see inside").arg(instance));
+  return {};
+}
+
+void Canvas::contextMenuEvent(QContextMenuEvent* e) {
+  // Right-click on a block not selected selects it alone, as file managers do.
+  for (QGraphicsItem* item : items(e->pos()))
+    for (QGraphicsItem* at = item; at; at = at->parentItem())
+      if (auto* b = qgraphicsitem_cast<BlockItem*>(at); b && !b->isSelected()) {
+        scene_.clearSelection();
+        b->setSelected(true);
+      }
+  const QStringList sel = selected_blocks();
+  QMenu menu;
+  QAction* group = menu.addAction(tr("&Group into subsystem (%1 blocks)").arg(sel.size()), this, [this] { group_selection(); });
+  group->setEnabled(at_scene_level() && !sel.isEmpty());
+  QAction* open = menu.addAction(tr("&Open subsystem"), this, [this, sel] { open_subsystem(sel.front()); });
+  const DocBlock* one = sel.size() == 1 && at_scene_level() ? controller_->document().find_block(sel.front().toStdString()) : nullptr;
+  open->setEnabled(one && controller_->document().subsystem_of(*one));
+  menu.exec(e->globalPos());
 }
 
 void Canvas::keyPressEvent(QKeyEvent* e) {

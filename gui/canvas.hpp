@@ -55,12 +55,21 @@ class Canvas : public QGraphicsView {
   void close_subsystem(int levels = 1);
   /// The instances opened, outermost first; empty at the scene's level.
   const QStringList& level() const { return level_; }
-  /// A block with more than kPortsShownAll ports shows only those wired or logged, unless
-  /// toggled to show all (View > Show all ports).
-  static constexpr size_t kPortsShownAll = 30;
+  /// A block with more than kPortsShownAll ports (ports_in_use.hpp) shows only those wired or
+  /// logged, unless toggled to show all (View > Show all ports).
   void toggle_all_ports(const QString& block);
-  /// Whether the level shown is the scene's own (editable) one.
+  /// Whether the level shown is the scene's own one.
   bool at_scene_level() const { return level_.isEmpty(); }
+  /// The definition shown inside the instances opened (null at the scene's level); `instance`
+  /// receives the innermost instance with its values bound.
+  const DocSubsystem* definition_shown(DocBlock* instance = nullptr) const;
+  /// Its name ("" at the scene's level).
+  QString definition_name() const;
+  /// Whether blocks shown can be moved and edited: the scene's level, or an inline definition.
+  bool level_editable() const;
+  /// Groups the selected blocks into a new subsystem (SceneController::group_into_subsystem);
+  /// "" when done (the instance is then selected), else why not.
+  QString group_selection();
 
  signals:
   void message(const QString& text);
@@ -80,6 +89,7 @@ class Canvas : public QGraphicsView {
   void keyPressEvent(QKeyEvent* e) override;
   void wheelEvent(QWheelEvent* e) override;
   void mouseDoubleClickEvent(QMouseEvent* e) override;
+  void contextMenuEvent(QContextMenuEvent* e) override;
 
  private:
   /// What is drawn at the current level: blocks, connections and each block's ports.

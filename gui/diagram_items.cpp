@@ -30,6 +30,23 @@ std::string signature(const DocBlock& b, const BlockPorts& ports) {
 
 }  // namespace
 
+QSizeF block_size(const DocBlock& block, const BlockPorts& ports) {
+  const QFont font;
+  QFont bold = font;
+  bold.setBold(true);
+  const QFontMetricsF fm(font), fb(bold);
+  const size_t rows = std::max<size_t>({ports.inputs.size(), ports.outputs.size(), 1});
+  double left = 0, right = 0;
+  for (const auto& p : ports.inputs) left = std::max(left, fm.horizontalAdvance(port_label(p)));
+  for (const auto& p : ports.outputs) right = std::max(right, fm.horizontalAdvance(port_label(p)));
+  const double width = std::max({150.0, left + right + 40.0, fb.horizontalAdvance(q(block.name)) + 24.0,
+                                 fm.horizontalAdvance(q(block.type)) + 24.0});
+  const double height = kHeader + kRow * static_cast<double>(rows) + (ports.is_objective ? kRow : 6.0);
+  return {width, height};
+}
+
+double port_offset(size_t k) { return kHeader + kRow * (static_cast<double>(k) + 0.5); }
+
 PortItem::PortItem(QGraphicsItem* parent, std::string block, const engine::PortDecl& decl, bool input)
     : QGraphicsEllipseItem(-kPortRadius, -kPortRadius, 2 * kPortRadius, 2 * kPortRadius, parent),
       block_(std::move(block)), name_(decl.name), input_(input), width_(decl.width) {
@@ -65,31 +82,21 @@ BlockItem::BlockItem(const DocBlock& block, const std::string& summary, const Bl
       ports_error_(q(ports.error)), objective_(ports.is_objective) {
   setFlags(ItemIsMovable | ItemIsSelectable | ItemSendsGeometryChanges);
   setAcceptHoverEvents(true);
-  const QFont font;
-  QFont bold = font;
-  bold.setBold(true);
-  const QFontMetricsF fm(font), fb(bold);
   const size_t rows = std::max<size_t>({ports.inputs.size(), ports.outputs.size(), 1});
-  double left = 0, right = 0;
-  for (size_t r = 0; r < rows; ++r) {
-    const QString in = r < ports.inputs.size() ? port_label(ports.inputs[r]) : QString();
-    const QString out = r < ports.outputs.size() ? port_label(ports.outputs[r]) : QString();
-    left = std::max(left, fm.horizontalAdvance(in));
-    right = std::max(right, fm.horizontalAdvance(out));
-    rows_.emplace_back(in, out);
-  }
-  const double width = std::max({150.0, left + right + 40.0, fb.horizontalAdvance(q(name_)) + 24.0,
-                                 fm.horizontalAdvance(q(type_)) + 24.0});
-  const double height = kHeader + kRow * static_cast<double>(rows) + (objective_ ? kRow : 6.0);
-  setRect(0, 0, width, height);
+  for (size_t r = 0; r < rows; ++r)
+    rows_.emplace_back(r < ports.inputs.size() ? port_label(ports.inputs[r]) : QString(),
+                       r < ports.outputs.size() ? port_label(ports.outputs[r]) : QString());
+  const QSizeF size = block_size(block, ports);
+  const double width = size.width();
+  setRect(0, 0, width, size.height());
   for (size_t k = 0; k < ports.inputs.size(); ++k) {
     auto* p = new PortItem(this, name_, ports.inputs[k], true);
-    p->setPos(0, kHeader + kRow * (static_cast<double>(k) + 0.5));
+    p->setPos(0, port_offset(k));
     ports_.push_back(p);
   }
   for (size_t k = 0; k < ports.outputs.size(); ++k) {
     auto* p = new PortItem(this, name_, ports.outputs[k], false);
-    p->setPos(width, kHeader + kRow * (static_cast<double>(k) + 0.5));
+    p->setPos(width, port_offset(k));
     ports_.push_back(p);
   }
   setPos(block.x, block.y);

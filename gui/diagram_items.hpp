@@ -12,6 +12,11 @@
 
 namespace dydp::gui {
 
+/// The size a block is drawn with, given the ports it shows [px].
+QSizeF block_size(const DocBlock& block, const BlockPorts& ports);
+/// The height of the k-th input (or output) port below the block's top edge [px].
+double port_offset(size_t k);
+
 class PortItem : public QGraphicsEllipseItem {
  public:
   enum { Type = UserType + 1 };

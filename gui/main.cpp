@@ -1,5 +1,5 @@
 // dydp-gui: edit and run dydp scenes as block diagrams.
-//   dydp-gui [SCENE] [--run] [--screenshot FILE.png]
+//   dydp-gui [SCENE] [--run] [--plot SIGNAL,SIGNAL] [--screenshot FILE.png]
 // With --screenshot the window is shown, the scene run (with --run) and the window saved as an
 // image, then the program exits (used by scripts/gui_screenshot.sh).
 #include <QApplication>
@@ -20,7 +20,9 @@ int main(int argc, char** argv) {
   const QCommandLineOption run_option("run", "run the scene once opened");
   const QCommandLineOption shot_option("screenshot", "save the window to FILE and exit", "FILE");
   const QCommandLineOption size_option("size", "window size WxH", "WxH", "1600x1000");
-  cli.addOptions({run_option, shot_option, size_option});
+  const QCommandLineOption plot_option("plot", "after the run, plot these logged signals overlaid (comma-separated)",
+                                       "SIGNALS");
+  cli.addOptions({run_option, shot_option, size_option, plot_option});
   cli.process(app);
 
   dydp::gui::MainWindow window;
@@ -52,6 +54,16 @@ int main(int argc, char** argv) {
       QApplication::exit(ok ? 0 : 1);
     });
   };
+  if (cli.isSet(plot_option))
+    QObject::connect(&window, &dydp::gui::MainWindow::run_ended, &window, [&] {
+      std::vector<int> chosen;
+      QListWidget* list = window.results()->signal_list();
+      for (const QString& name : cli.value(plot_option).split(','))
+        for (int row = 0; row < list->count(); ++row)
+          if (list->item(row)->text().section(' ', 0, 0) == name.trimmed()) chosen.push_back(row);
+      const QString why = window.results()->plot_signals(chosen);
+      if (!why.isEmpty()) std::fprintf(stderr, "--plot: %s\n", why.toUtf8().constData());
+    });
   if (cli.isSet(run_option)) {
     QTimer::singleShot(200, &window, [&] {
       if (!window.start_run()) {

@@ -76,6 +76,13 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   edit->addAction(redo);
   auto* act_delete = edit->addAction(tr("&Delete"), this, [this] { canvas_->delete_selection(); });
   edit->addAction(tr("&Fit diagram"), this, [this] { canvas_->fit_all(); });
+  edit->addAction(tr("&Group into subsystem"), QKeySequence(Qt::CTRL | Qt::Key_G), this,
+                  [this] { canvas_->group_selection(); });
+  edit->addAction(tr("&Lay out diagram"), QKeySequence(Qt::CTRL | Qt::Key_L), this, [this] {
+    if (!canvas_->at_scene_level()) return status(tr("Lay out works on the scene's level: go back up first"));
+    controller_.lay_out();
+    canvas_->fit_all();
+  });
   auto* view = menuBar()->addMenu(tr("&View"));
   view->addAction(tr("&Open subsystem"), QKeySequence(Qt::ALT | Qt::Key_Down), this, [this] {
     const QStringList sel = canvas_->selected_blocks();
@@ -136,7 +143,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   connect(properties_, &PropertyEditor::message, this, &MainWindow::status);
   connect(scene_panel_, &ScenePanel::message, this, &MainWindow::status);
   connect(canvas_, &Canvas::selection_changed, this, [this, tabs](const QString& block) {
-    properties_->set_block(block);
+    properties_->set_block(block, canvas_->definition_name());
     if (!block.isEmpty()) tabs->setCurrentWidget(properties_);
   });
   connect(palette_, &Palette::activated_type, this, [this](const QString& type) {
@@ -164,7 +171,8 @@ void MainWindow::update_breadcrumb(const QStringList& level) {
   for (qsizetype i = 0; i < level.size(); ++i)
     text += " \u25b8 " + (i + 1 == level.size() ? "<b>" + level[i].toHtmlEscaped() + "</b>"
                                                 : QString("<a href=\"%1\">%2</a>").arg(i + 1).arg(level[i].toHtmlEscaped()));
-  if (!level.isEmpty()) text += tr("  <i>(read only; Alt+Up: back)</i>");
+  if (!level.isEmpty())
+    text += canvas_->level_editable() ? tr("  <i>(Alt+Up: back)</i>") : tr("  <i>(read only; Alt+Up: back)</i>");
   breadcrumb_->setText(text);
 }
 

@@ -83,7 +83,7 @@ PropertyEditor::PropertyEditor(SceneController* controller, QWidget* parent)
   connect(controller_, &SceneController::document_changed, this, &PropertyEditor::refresh,
           Qt::QueuedConnection);
   connect(name_, &QLineEdit::editingFinished, this, [this] {
-    if (refreshing_ || block_.isEmpty() || name_->text() == block_) return;
+    if (refreshing_ || block_.isEmpty() || !subsystem_.isEmpty() || name_->text() == block_) return;
     const QString to = name_->text().trimmed();
     const QString why = controller_->rename_block(block_, to);
     if (why.isEmpty()) {
@@ -114,14 +114,16 @@ QString PropertyEditor::make_direction(const QString& key) {
   return why;
 }
 
-void PropertyEditor::set_block(const QString& name) {
+void PropertyEditor::set_block(const QString& name, const QString& subsystem) {
   block_ = name;
+  subsystem_ = name.isEmpty() ? QString() : subsystem;
   status_->clear();
   refresh();
 }
 
 QString PropertyEditor::edit_value(const QString& key, const QString& text) {
-  const QString why = controller_->set_block_value(block_, key, text.trimmed());
+  const QString why = subsystem_.isEmpty() ? controller_->set_block_value(block_, key, text.trimmed())
+                                           : controller_->set_block_value_in(subsystem_, block_, key, text.trimmed());
   status_->setText(why);
   if (!why.isEmpty()) emit message(tr("refused: %1").arg(why));
   // A refused value goes back to the document's.
@@ -132,20 +134,26 @@ QString PropertyEditor::edit_value(const QString& key, const QString& text) {
 void PropertyEditor::refresh() {
   refreshing_ = true;
   const SceneDocument& doc = controller_->document();
-  const DocBlock* b = doc.find_block(block_.toStdString());
+  const DocSubsystem* inside = subsystem_.isEmpty() ? nullptr : doc.find_subsystem(subsystem_.toStdString());
+  const DocBlock* b = inside ? inside->find_block(block_.toStdString())
+                             : subsystem_.isEmpty() ? doc.find_block(block_.toStdString()) : nullptr;
+  name_->setReadOnly(inside != nullptr);
+  make_direction_->setEnabled(inside == nullptr);
+  outputs_->setEnabled(inside == nullptr);
   const engine::BlockType* type = b ? engine::Registry::global().find(b->type) : nullptr;
   setEnabled(b != nullptr);
   table_->setRowCount(0);
   outputs_->clear();
   if (!b) {
     block_.clear();
+    subsystem_.clear();
     name_->clear();
     type_->clear();
     summary_->setText(tr("Select a block on the canvas."));
     refreshing_ = false;
     return;
   }
-  name_->setText(block_);
+  name_->setText(inside ? subsystem_ + "." + block_ : block_);
   type_->setText(q(b->type));
   const DocSubsystem* def = doc.subsystem_of(*b);
   summary_->setText(type ? q(type->summary)
@@ -162,7 +170,8 @@ void PropertyEditor::refresh() {
     table_->setItem(row, kName, name);
     auto* v = new QTableWidgetItem(value);
     v->setToolTip(setting ? tr("setting: a plain value, [a, b] for a list")
-                          : tr("a number, or $name of a scene parameter; empty: the default"));
+                  : inside ? tr("a number, or $name of a parameter of subsystem %1; empty: the default").arg(subsystem_)
+                           : tr("a number, or $name of a scene parameter; empty: the default"));
     table_->setItem(row, kValue, v);
     for (auto [col, text] : {std::pair{kUnit, unit}, {kDefault, def}, {kBounds, range}}) {
       auto* item = new QTableWidgetItem(text);
@@ -189,6 +198,11 @@ void PropertyEditor::refresh() {
       add_row(q(name), v ? q(v->text()) : QString(), {}, default_value.items.empty() ? tr("required") : q(default_value.text()),
               {}, tr("parameter of subsystem %1").arg(q(def->name)), false);
     }
+  if (inside) {
+    // Outputs inside are logged through the instance (`corner_fl.damper.force`) at the scene's level.
+    refreshing_ = false;
+    return;
+  }
   const BlockPorts ports = controller_->ports(b->name);
   auto add_output = [&](const QString& label, const QString& ref) {
     auto* item = new QListWidgetItem(label, outputs_);

@@ -19,8 +19,11 @@ class PropertyEditor : public QWidget {
 
  public:
   explicit PropertyEditor(SceneController* controller, QWidget* parent = nullptr);
-  void set_block(const QString& name);
+  /// Shows block `name` of the scene, or of the inline definition `subsystem` (opened on the
+  /// canvas): there its values are edited, its name and outputs are not.
+  void set_block(const QString& name, const QString& subsystem = {});
   const QString& block() const { return block_; }
+  const QString& subsystem() const { return subsystem_; }
   /// Applies text to the parameter or setting in `row` as if typed; returns the refusal or "".
   QString edit_value(const QString& key, const QString& text);
   QTableWidget* table() { return table_; }
@@ -37,6 +40,7 @@ class PropertyEditor : public QWidget {
  private:
   SceneController* controller_;
   QString block_;
+  QString subsystem_;  ///< "" for a block of the scene
   QLineEdit* name_;
   QLabel* type_;
   QLabel* summary_;

@@ -1,5 +1,7 @@
 #include "gui/results_panel.hpp"
 
+#include "gui/chart_curves.hpp"
+
 #include <QChart>
 #include <QChartView>
 #include <QHBoxLayout>
@@ -8,7 +10,6 @@
 #include <QLineSeries>
 #include <QSplitter>
 #include <QVBoxLayout>
-#include <QValueAxis>
 #include <algorithm>
 #include <cmath>
 
@@ -20,67 +21,10 @@ QString q(const std::string& s) { return QString::fromStdString(s); }
 QChartView* make_chart_view() {
   auto* view = new QChartView(new QChart);
   view->setRenderHint(QPainter::Antialiasing);
-  view->chart()->legend()->setAlignment(Qt::AlignRight);
+  view->chart()->legend()->setAlignment(Qt::AlignBottom);
   view->chart()->setMargins(QMargins(4, 4, 4, 4));
   view->setMinimumHeight(140);
   return view;
-}
-
-/// One curve of a chart: values against its own time grid; dashed for the previous run.
-struct Curve {
-  QString name;
-  const std::vector<double>* t;
-  std::vector<double> v;
-  bool dashed = false;
-};
-
-/// Replaces the chart's series by the given curves, with fitted axes.
-void set_curves(QChartView* view, const QString& title, const QString& y_title, const std::vector<Curve>& curves) {
-  QChart* chart = view->chart();
-  chart->removeAllSeries();
-  for (QAbstractAxis* a : chart->axes()) {
-    chart->removeAxis(a);
-    delete a;
-  }
-  chart->setTitle(title);
-  if (curves.empty() || curves.front().t->empty()) return;
-  double lo = INFINITY, hi = -INFINITY, t0 = INFINITY, t1 = -INFINITY;
-  auto* x = new QValueAxis;
-  auto* y = new QValueAxis;
-  x->setTitleText("t [s]");
-  y->setTitleText(y_title);
-  chart->addAxis(x, Qt::AlignBottom);
-  chart->addAxis(y, Qt::AlignLeft);
-  for (const Curve& c : curves) {
-    auto* s = new QLineSeries;
-    s->setName(c.name);
-    QList<QPointF> points;
-    points.reserve(static_cast<qsizetype>(c.t->size()));
-    for (size_t k = 0; k < c.t->size() && k < c.v.size(); ++k) {
-      points.append({(*c.t)[k], c.v[k]});
-      lo = std::min(lo, c.v[k]);
-      hi = std::max(hi, c.v[k]);
-    }
-    t0 = std::min(t0, c.t->front());
-    t1 = std::max(t1, c.t->back());
-    s->replace(points);
-    chart->addSeries(s);
-    s->attachAxis(x);
-    s->attachAxis(y);
-    if (c.dashed) {
-      QPen pen = s->pen();
-      pen.setStyle(Qt::DashLine);
-      pen.setColor(QColor(150, 150, 150));
-      s->setPen(pen);
-    }
-  }
-  x->setRange(t0, t1);
-  if (!(hi > lo)) {
-    lo -= 1;
-    hi += 1;
-  }
-  const double pad = 0.05 * (hi - lo);
-  y->setRange(lo - pad, hi + pad);
 }
 
 }  // namespace
@@ -96,9 +40,14 @@ ResultsPanel::ResultsPanel(QWidget* parent) : QWidget(parent) {
   objectives_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   objectives_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   left_layout->addWidget(objectives_);
-  left_layout->addWidget(new QLabel(tr("Signal")));
-  signal_ = new QComboBox;
-  left_layout->addWidget(signal_);
+  left_layout->addWidget(new QLabel(tr("Signals (tick several to overlay them)")));
+  signal_list_ = new QListWidget;
+  signal_list_->setObjectName("signal_list");
+  left_layout->addWidget(signal_list_);
+  plot_message_ = new QLabel;
+  plot_message_->setWordWrap(true);
+  plot_message_->setStyleSheet("color: #c02020;");
+  left_layout->addWidget(plot_message_);
   auto* charts = new QSplitter(Qt::Horizontal);
   value_chart_ = make_chart_view();
   sens_chart_ = make_chart_view();
@@ -111,7 +60,15 @@ ResultsPanel::ResultsPanel(QWidget* parent) : QWidget(parent) {
   // Wide enough for an objective, a dψ/dp label and a value to the last digit with its unit.
   left->setMinimumWidth(520);
   layout->addWidget(split);
-  connect(signal_, &QComboBox::currentIndexChanged, this, &ResultsPanel::plot_signal);
+  connect(signal_list_, &QListWidget::itemChanged, this, [this](QListWidgetItem* item) {
+    const int i = signal_list_->row(item);
+    std::vector<int> want = plotted_;
+    std::erase(want, i);
+    if (item->checkState() == Qt::Checked) want.push_back(i);
+    if (want == plotted_) return;
+    // A refused signal is unticked again by plot_signals (through tick_plotted).
+    if (!plot_signals(want).isEmpty()) tick_plotted();
+  });
   clear();
 }
 
@@ -121,9 +78,14 @@ void ResultsPanel::clear() {
   objectives_->setRowCount(0);
   objectives_->setColumnCount(4);
   objectives_->setHorizontalHeaderLabels({tr("objective"), tr("quantity"), tr("value"), tr("unit")});
-  signal_->clear();
-  set_curves(value_chart_, tr("signal"), {}, {});
-  set_curves(sens_chart_, tr("sensitivities"), {}, {});
+  plotted_.clear();
+  {
+    const QSignalBlocker block(signal_list_);
+    signal_list_->clear();
+  }
+  plot_message_->clear();
+  draw_curves(value_chart_->chart(), tr("signal"), {}, {});
+  draw_curves(sens_chart_->chart(), tr("sensitivities"), {}, {});
 }
 
 void ResultsPanel::forget_runs() {
@@ -170,8 +132,13 @@ void ResultsPanel::show_result(std::shared_ptr<const engine::RunResult> result,
           q(engine::unit_per(o.unit, parameter_unit(d).toStdString())));
   }
   {
-    const QSignalBlocker block(signal_);
-    for (const auto& name : r.signal_names) signal_->addItem(q(name));
+    const QSignalBlocker block(signal_list_);
+    for (size_t i = 0; i < r.signal_names.size(); ++i) {
+      const QString unit = signal_unit(static_cast<int>(i));
+      auto* item = new QListWidgetItem(q(r.signal_names[i]) + (unit.isEmpty() ? "" : " [" + unit + "]"), signal_list_);
+      item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsUserCheckable | Qt::ItemIsSelectable);
+      item->setCheckState(Qt::Unchecked);
+    }
   }
   if (!r.signal_names.empty()) plot_signal(0);
 }
@@ -182,45 +149,81 @@ int ResultsPanel::find_row(const QString& objective, const QString& quantity) co
   return -1;
 }
 
-void ResultsPanel::plot_signal(int i) {
-  if (!result_ || i < 0 || i >= result_->num_signals()) return;
+void ResultsPanel::plot_signal(int i) { plot_signals({i}); }
+
+QString ResultsPanel::plot_signals(const std::vector<int>& chosen) {
+  if (!result_) return tr("no run to plot");
+  std::vector<QString> units;
+  for (int i : chosen) {
+    if (i < 0 || i >= result_->num_signals()) return tr("no signal %1").arg(i);
+    if (std::find(units.begin(), units.end(), signal_unit(i)) == units.end()) units.push_back(signal_unit(i));
+  }
+  // One chart has a left and a right axis: a third unit would have no axis to be read against.
+  if (units.size() > 2) {
+    const int refused = chosen.back();
+    const QString why = tr("%1 [%2] not drawn: the chart already shows %3 and %4 (one unit per axis); "
+                           "untick a signal of one of those first")
+                            .arg(q(result_->signal_names[refused]), signal_unit(refused), units[0], units[1]);
+    plot_message_->setText(why);
+    return why;
+  }
+  plot_message_->clear();
+  plotted_ = chosen;
+  tick_plotted();
+  draw_plotted();
+  return {};
+}
+
+void ResultsPanel::tick_plotted() {
+  const QSignalBlocker block(signal_list_);
+  for (int row = 0; row < signal_list_->count(); ++row) {
+    const bool on = std::find(plotted_.begin(), plotted_.end(), row) != plotted_.end();
+    signal_list_->item(row)->setCheckState(on ? Qt::Checked : Qt::Unchecked);
+  }
+}
+
+void ResultsPanel::draw_plotted() {
   const auto& r = *result_;
   const size_t n = r.t.size();
-  std::vector<double> v(n);
-  for (size_t k = 0; k < n; ++k) v[k] = r.value(static_cast<int>(k), i);
-  const QString name = q(r.signal_names[i]);
-  const QString unit = signal_unit(i);
-  std::vector<Curve> values = {{name, &r.t, std::move(v)}};
-  // The same signal of the previous run, when it has one.
-  const int j = previous_ ? previous_->signal_index(r.signal_names[i]) : -1;
-  if (j >= 0) {
-    std::vector<double> pv(previous_->t.size());
-    for (size_t k = 0; k < pv.size(); ++k) pv[k] = previous_->value(static_cast<int>(k), j);
-    values.push_back({name + tr(" (previous run)"), &previous_->t, std::move(pv), true});
-  }
-  set_curves(value_chart_, name, unit.isEmpty() ? name : QString("%1 [%2]").arg(name, unit), values);
-  std::vector<Curve> sens;
-  if (!r.tangents.empty()) {
-    for (size_t d = 0; d < r.sensitivity_names.size(); ++d) {
+  std::vector<Curve> values, sens;
+  QStringList names;
+  for (int i : plotted_) {
+    const QString name = q(r.signal_names[i]);
+    const QString unit = signal_unit(i);
+    names << name;
+    std::vector<double> v(n);
+    for (size_t k = 0; k < n; ++k) v[k] = r.value(static_cast<int>(k), i);
+    values.push_back({name, unit, &r.t, std::move(v)});
+    // The same signal of the previous run, when it has one.
+    const int j = previous_ ? previous_->signal_index(r.signal_names[i]) : -1;
+    if (j >= 0) {
+      std::vector<double> pv(previous_->t.size());
+      for (size_t k = 0; k < pv.size(); ++k) pv[k] = previous_->value(static_cast<int>(k), j);
+      values.push_back({name + tr(" (previous run)"), unit, &previous_->t, std::move(pv), true});
+    }
+    for (size_t d = 0; d < r.sensitivity_names.size() && !r.tangents.empty(); ++d) {
       std::vector<double> dv(n);
       for (size_t k = 0; k < n; ++k) dv[k] = r.tangent(static_cast<int>(k), static_cast<int>(d), i);
       const QString per = q(engine::unit_per(unit.toStdString(), parameter_unit(d).toStdString()));
-      sens.push_back({QString("d/d%1").arg(q(r.sensitivity_names[d])) + (per.isEmpty() ? "" : " [" + per + "]"),
-                      &r.t, std::move(dv)});
+      const QString label = plotted_.size() == 1 ? QString("d/d%1").arg(q(r.sensitivity_names[d]))
+                                                 : QString("d(%1)/d%2").arg(name, q(r.sensitivity_names[d]));
+      sens.push_back({label + (per.isEmpty() ? "" : " [" + per + "]"), per, &r.t, std::move(dv)});
     }
   }
-  // The axis names the unit when all directions share it; else each curve's name carries its own.
-  QString per_all;
-  for (size_t d = 0; d < r.sensitivity_names.size(); ++d) {
-    const QString per = q(engine::unit_per(unit.toStdString(), parameter_unit(d).toStdString()));
-    per_all = d == 0 || per == per_all ? per : QString("mixed");
-  }
-  set_curves(sens_chart_, tr("sensitivities of %1").arg(name),
-             QString("d(%1)/dp").arg(name) + (per_all.isEmpty() || per_all == "mixed" ? "" : " [" + per_all + "]"), sens);
-  if (signal_->currentIndex() != i) {
-    const QSignalBlocker block(signal_);
-    signal_->setCurrentIndex(i);
-  }
+  // An axis is named after its signals when they are few, with their unit.
+  const auto value_axis = [&](const QString& unit) {
+    QStringList of;
+    for (int i : plotted_)
+      if (signal_unit(i) == unit) of << q(r.signal_names[i]);
+    const QString what = of.size() <= 2 ? of.join(", ") : tr("value");
+    return unit.isEmpty() ? what : QString("%1 [%2]").arg(what, unit);
+  };
+  const QString title = names.join(", ");
+  draw_curves(value_chart_->chart(), title, values, value_axis);
+  const QString of = names.size() == 1 ? names.front() : tr("signals");
+  draw_curves(sens_chart_->chart(), tr("sensitivities of %1").arg(title), sens, [&](const QString& per) {
+    return QString("d(%1)/dp").arg(of) + (per.isEmpty() ? "" : " [" + per + "]");
+  });
 }
 
 }  // namespace dydp::gui

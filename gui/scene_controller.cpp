@@ -1,5 +1,8 @@
 #include "gui/scene_controller.hpp"
 
+#include "gui/automatic_layout.hpp"
+#include "gui/subsystem_grouping.hpp"
+#include "gui/subsystem_yaml.hpp"
 #include "gui/subsystem_ports.hpp"
 
 #include <QDir>
@@ -47,6 +50,18 @@ const engine::PortDecl* find_port(const std::vector<engine::PortDecl>& ports, co
   return nullptr;
 }
 
+/// Why `text` is not a value of parameter `spec` ("" when it is, or when it is empty or a $reference).
+QString check_number(const engine::ParamSpec& spec, const QString& field, const std::string& text) {
+  if (text.empty()) return spec.required ? QObject::tr("%1: required parameter").arg(field) : QString();
+  if (text[0] == '$') return {};
+  double v = 0;
+  if (!engine::parse_number(text, v)) return QObject::tr("%1: malformed number '%2'").arg(field, q(text));
+  if (v < spec.lower || v > spec.upper)
+    return QObject::tr("%1: value %2 outside [%3, %4] %5")
+        .arg(field, q(text)).arg(spec.lower).arg(spec.upper).arg(q(spec.unit)).trimmed();
+  return {};
+}
+
 }  // namespace
 
 SceneController::SceneController(QObject* parent) : QObject(parent) { new_scene(); }
@@ -64,8 +79,8 @@ void SceneController::new_scene() {
 
 void SceneController::open(const QString& path) {
   SceneDocument doc = read_scene_file(s(path));
-  place_unplaced_blocks(doc);
-  for (DocSubsystem& def : doc.subsystems) place_unplaced_blocks(def.blocks, def.connections);
+  lay_out_scene(doc, LayoutScope::unplaced_blocks);
+  for (DocSubsystem& def : doc.subsystems) lay_out_definition(doc, def, LayoutScope::unplaced_blocks);
   undo_.clear();
   path_ = path;
   replace(doc);
@@ -111,37 +126,78 @@ BlockPorts SceneController::ports(const std::string& block) const {
   return it->second;
 }
 
-void SceneController::place_unplaced_blocks(SceneDocument& doc) const {
-  place_unplaced_blocks(doc.blocks, doc.connections);
+void SceneController::lay_out() {
+  SceneDocument after = doc_;
+  lay_out_scene(after, LayoutScope::all_blocks);
+  commit(tr("Lay out diagram"), std::move(after));
 }
 
-void SceneController::place_unplaced_blocks(std::vector<DocBlock>& blocks,
-                                            const std::vector<DocConnection>& connections) const {
-  // Columns by signal flow: a block sits one column right of the furthest block driving it
-  // (longest path from the sources; cycles stop growing after as many rounds as blocks).
-  std::map<std::string, int> column;
-  for (const auto& b : blocks) column[b.name] = 0;
-  for (size_t round = 0; round < blocks.size(); ++round) {
-    bool changed = false;
-    for (const auto& c : connections) {
-      if (!column.count(c.from.block) || !column.count(c.to.block) || c.from.block == c.to.block) continue;
-      const int want = column[c.from.block] + 1;
-      if (column[c.to.block] < want && want < static_cast<int>(blocks.size())) {
-        column[c.to.block] = want;
-        changed = true;
-      }
-    }
-    if (!changed) break;
+QString SceneController::group_into_subsystem(const QStringList& blocks, QString* instance) {
+  std::vector<std::string> names;
+  for (const QString& b : blocks) names.push_back(s(b));
+  Grouping g = dydp::gui::group_into_subsystem(doc_, names);
+  if (!g.error.empty()) return q(g.error);
+  if (instance) *instance = q(g.instance);
+  commit(tr("Group %1 blocks into subsystem %2").arg(blocks.size()).arg(q(g.instance)), std::move(g.after));
+  return {};
+}
+
+namespace {
+
+DocSubsystem* editable(SceneDocument& doc, const std::string& name) {
+  for (DocSubsystem& d : doc.subsystems)
+    if (d.name == name) return d.file.empty() && d.error.empty() ? &d : nullptr;
+  return nullptr;
+}
+
+}  // namespace
+
+bool SceneController::definition_editable(const QString& subsystem) const {
+  const DocSubsystem* d = doc_.find_subsystem(s(subsystem));
+  return d && d->file.empty() && d->error.empty();
+}
+
+void SceneController::move_block_in(const QString& subsystem, const QString& block, QPointF pos) {
+  SceneDocument after = doc_;
+  DocSubsystem* def = editable(after, s(subsystem));
+  DocBlock* b = def ? def->find_block(s(block)) : nullptr;
+  if (!b) return;
+  b->x = std::round(pos.x());
+  b->y = std::round(pos.y());
+  store_inside(*def);
+  commit(tr("Move %1.%2").arg(subsystem, block), std::move(after));
+}
+
+QString SceneController::set_block_value_in(const QString& subsystem, const QString& block_name,
+                                            const QString& key_q, const QString& text_q) {
+  const std::string key = s(key_q), text = s(text_q).empty() ? "" : SceneValue::parse(s(text_q)).text();
+  SceneDocument after = doc_;
+  DocSubsystem* def = editable(after, s(subsystem));
+  if (!def) return tr("subsystem %1 is defined in a file of its own: edit it there").arg(subsystem);
+  DocBlock* b = def->find_block(s(block_name));
+  const QString field = subsystem + "." + block_name + "." + key_q;
+  if (!b) return tr("no block '%1' in subsystem %2").arg(block_name, subsystem);
+  const engine::BlockType* type = engine::Registry::global().find(b->type);
+  if (!type) return tr("%1: only blocks of the library are edited inside a subsystem").arg(field);
+  const bool own_parameter = !text.empty() && text[0] == '$' &&
+                             std::any_of(def->parameters.begin(), def->parameters.end(),
+                                         [&](const auto& p) { return "$" + p.first == text; });
+  if (!text.empty() && text[0] == '$' && !own_parameter)
+    return tr("%1: '%2' is not a parameter of subsystem %3 (inside, $name names the subsystem's own)")
+        .arg(field, q(text), subsystem);
+  if (const int j = parameter_index(*type, key); j >= 0) {
+    if (const QString why = check_number(type->parameters[j], field, text); !why.isEmpty()) return why;
+    b->set(key, SceneValue::scalar(text));
+  } else if (setting_index(*type, key) >= 0) {
+    b->set(key, text.empty() ? SceneValue::scalar("") : SceneValue::parse(text));
+    if (!own_parameter)
+      if (const BlockPorts p = ports_of(*type, *b); !p.error.empty()) return q(p.error);
+  } else {
+    return tr("%1: unknown parameter of %2").arg(field, q(type->name));
   }
-  std::map<int, int> rows;
-  for (auto& b : blocks) {
-    const int col = column[b.name];
-    const int row = rows[col]++;
-    if (b.placed) continue;
-    b.x = 40 + 260 * col;
-    b.y = 40 + 170 * row;
-    b.placed = true;
-  }
+  store_inside(*def);
+  commit(tr("Set %1").arg(field), std::move(after));
+  return {};
 }
 
 QString SceneController::add_block(const QString& type_name, QPointF pos) {
@@ -295,12 +351,8 @@ QString SceneController::set_block_value(const QString& block_name, const QStrin
       if (!spec.differentiable && direction)
         return tr("%1: not differentiable, cannot be driven by sensitivity parameter '%2'")
             .arg(field, q(sp->name));
-    } else if (!text.empty()) {
-      double v = 0;
-      if (!engine::parse_number(text, v)) return tr("%1: malformed number '%2'").arg(field, q(text));
-      if (v < spec.lower || v > spec.upper)
-        return tr("%1: value %2 outside [%3, %4] %5")
-            .arg(field, q(text)).arg(spec.lower).arg(spec.upper).arg(q(spec.unit)).trimmed();
+    } else if (const QString why = check_number(spec, field, text); !why.isEmpty()) {
+      return why;
     }
     b->set(key, SceneValue::scalar(text));
   } else if (setting_index(*type, key) >= 0) {

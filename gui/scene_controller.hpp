@@ -30,7 +30,8 @@ class SceneController : public QObject {
   bool modified() const { return !undo_.isClean(); }
 
   void new_scene();
-  /// Opens a scene file; blocks without a layout position are placed in columns by signal flow.
+  /// Opens a scene file; blocks without a layout position are placed by the layered layout
+  /// (automatic_layout.hpp), below those that have one.
   /// Throws engine::InputError when the file is not a scene.
   void open(const QString& path);
   /// Writes the scene (with its layout) to path; throws std::exception on failure.
@@ -41,6 +42,20 @@ class SceneController : public QObject {
   QString add_block(const QString& type, QPointF pos);
   void remove_blocks(const QStringList& names);
   void move_block(const QString& name, QPointF pos);
+  /// Places every block of the scene anew by the layered layout (one undo step).
+  void lay_out();
+  /// Replaces the blocks by one instance of a new inline subsystem definition (subsystem_grouping.hpp);
+  /// `instance` receives its name.
+  QString group_into_subsystem(const QStringList& blocks, QString* instance = nullptr);
+
+  // Edits inside a subsystem definition written inline in the scene (one written in a file of
+  // its own is read only here: other scenes include it too).
+  /// Whether the definition named `subsystem` can be edited here.
+  bool definition_editable(const QString& subsystem) const;
+  void move_block_in(const QString& subsystem, const QString& block, QPointF pos);
+  /// A parameter or setting of a block inside: a number, `$name` of the definition's own
+  /// parameters, or a setting; checked as set_block_value checks the scene's blocks.
+  QString set_block_value_in(const QString& subsystem, const QString& block, const QString& key, const QString& text);
   QString connect_ports(const QString& from, const QString& to);
   /// Why `from -> to` cannot be wired ("" when it can); changes nothing.
   QString check_connection(const QString& from, const QString& to) const;
@@ -84,8 +99,6 @@ class SceneController : public QObject {
   /// Pushes the change from the current document to `after` as one undo step (none if equal).
   void commit(const QString& label, SceneDocument after);
   void replace(const SceneDocument& doc);
-  void place_unplaced_blocks(SceneDocument& doc) const;
-  void place_unplaced_blocks(std::vector<DocBlock>& blocks, const std::vector<DocConnection>& connections) const;
   /// Drops connections and outputs that the block's current ports no longer support.
   void drop_dangling(SceneDocument& doc, const std::string& block) const;
 

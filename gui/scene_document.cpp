@@ -97,6 +97,12 @@ bool PortRef::parse(const std::string& text, PortRef& out) {
   return true;
 }
 
+DocBlock* DocSubsystem::find_block(const std::string& n) {
+  for (auto& b : blocks)
+    if (b.name == n) return &b;
+  return nullptr;
+}
+
 const DocBlock* DocSubsystem::find_block(const std::string& name) const {
   for (const DocBlock& b : blocks)
     if (b.name == name) return &b;

@@ -73,7 +73,7 @@ struct DocConnection {
 
 /// A subsystem definition of the scene (docs/scenes.md, "Subsystems"), included from a file or
 /// written inline. An instance (`type: subsystem.NAME`) is drawn as one block with the
-/// definition's ports; opening it shows the blocks inside. The GUI does not edit definitions.
+/// definition's ports; opening it shows the blocks inside, editable in an inline definition.
 struct DocSubsystem {
   std::string name;
   std::string file;          ///< `{file: PATH}` as written; empty: inline
@@ -89,6 +89,7 @@ struct DocSubsystem {
   std::vector<DocConnection> connections;   ///< inside
 
   const DocBlock* find_block(const std::string& name) const;
+  DocBlock* find_block(const std::string& name);
   bool operator==(const DocSubsystem&) const = default;
 };
 

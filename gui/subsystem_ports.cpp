@@ -104,6 +104,8 @@ DocBlock bound_block(const DocSubsystem& def, const DocBlock& instance, const Do
   return out;
 }
 
+BlockPorts block_ports(const SceneDocument& doc, const DocBlock& block) { return ports_at(doc, block, 0); }
+
 BlockPorts instance_ports(const SceneDocument& doc, const DocBlock& instance) {
   return instance_ports_at(doc, instance, 0);
 }

@@ -1,5 +1,6 @@
 #include "gui/subsystem_yaml.hpp"
 
+#include <cmath>
 #include <filesystem>
 
 #include "engine/errors.hpp"
@@ -47,7 +48,47 @@ void read_body(const YAML::Node& body, DocSubsystem& def) {
   def.connections = doc.connections;
 }
 
+YAML::Node value_node(const SceneValue& v) {
+  if (!v.is_list && !v.is_map) return YAML::Node(v.items.empty() ? std::string() : v.items.front());
+  YAML::Node n(v.is_map ? YAML::NodeType::Map : YAML::NodeType::Sequence);
+  for (size_t k = 0; k < v.items.size(); ++k) {
+    if (v.is_map) n[v.keys[k]] = v.items[k];
+    else n.push_back(v.items[k]);
+  }
+  n.SetStyle(YAML::EmitterStyle::Flow);
+  return n;
+}
+
 }  // namespace
+
+void store_inside(DocSubsystem& def) {
+  const YAML::Node old = def.inline_yaml.empty() ? YAML::Node(YAML::NodeType::Map) : YAML::Load(def.inline_yaml);
+  // Rebuilt key by key so that the order stays that of docs/scenes.md.
+  YAML::Node body(YAML::NodeType::Map);
+  for (const char* key : {"description", "parameters", "inputs", "outputs", "subsystems"})
+    if (old[key]) body[key] = old[key];
+  YAML::Node blocks(YAML::NodeType::Map), layout(YAML::NodeType::Map);
+  for (const DocBlock& b : def.blocks) {
+    YAML::Node block(YAML::NodeType::Map);
+    block["type"] = b.type;
+    for (const auto& [key, value] : b.values) block[key] = value_node(value);
+    block.SetStyle(YAML::EmitterStyle::Flow);
+    blocks[b.name] = block;
+    YAML::Node at(YAML::NodeType::Sequence);
+    at.push_back(static_cast<long>(std::lround(b.x)));
+    at.push_back(static_cast<long>(std::lround(b.y)));
+    at.SetStyle(YAML::EmitterStyle::Flow);
+    layout[b.name] = at;
+  }
+  body["blocks"] = blocks;
+  if (!def.connections.empty()) {
+    YAML::Node connections(YAML::NodeType::Sequence);
+    for (const DocConnection& c : def.connections) connections.push_back(c.text());
+    body["connections"] = connections;
+  }
+  body["layout"] = layout;
+  def.inline_yaml = YAML::Dump(body);
+}
 
 std::vector<DocSubsystem> read_subsystems(const YAML::Node& section, const std::string& file) {
   std::vector<DocSubsystem> out;

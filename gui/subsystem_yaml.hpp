@@ -17,6 +17,11 @@ namespace dydp::gui {
 /// with its error (the engine reports it when the scene is run).
 std::vector<DocSubsystem> read_subsystems(const YAML::Node& section, const std::string& file);
 
+/// Writes an inline definition's blocks, connections and positions (`layout:`) into its
+/// inline_yaml, keeping its other keys (description, parameters, ports): after the GUI has
+/// changed the inside of the definition.
+void store_inside(DocSubsystem& def);
+
 /// Emits `subsystems: ...` (nothing when there are none) into an open mapping.
 void emit_subsystems(YAML::Emitter& e, const std::vector<DocSubsystem>& subsystems);
 
