@@ -180,6 +180,10 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   part(name + "_residual.inverse_dynamics", *lists.applied, 0, n);
   part(name + "_residual.constraint_accelerations", *lists.applied, n, n + m);
   part(name + "_residual_tangent.primal_with_cut_forces", *lists.residual, 0, n);
+  if (lists.constraint_kinematics) {
+    part(name + "_constraints.h_J_Jdot_qd", *lists.constraint_kinematics, 0, m + m * n + m);
+    part(name + "_constraints.Jdot_qd", *lists.constraint_kinematics, m + m * n, m + m * n + m);
+  }
   kinematics.push_back(plain(name + "_constraints", *lists.constraints));
   kinematics.push_back(tangent(name + "_constraints_tangent", *lists.position_constraints, all_seeded));
   kinematics.push_back(tangent(name + "_velocity_constraints_tangent", *lists.velocity_constraints, all_seeded));

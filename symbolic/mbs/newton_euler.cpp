@@ -9,6 +9,7 @@
 #include <array>
 #include <functional>
 #include <map>
+#include <tuple>
 
 #include "symbolic/compact.hpp"
 #include "symbolic/differentiate.hpp"
@@ -135,6 +136,13 @@ class Generator {
       std::vector<Output> o = outputs("h", h);
       for (const Output& a : outputs("hdot", jqd)) o.push_back(a);
       out_.velocity_constraints = merged(o, {}, o);
+    }
+    if (const std::vector<Expr> bias = constraint_bias(); mc > 0 && !bias.empty()) {
+      std::vector<Output> o = outputs("h", h);
+      for (int i = 0; i < mc; ++i)
+        for (int j = 0; j < n; ++j) o.push_back({"J[" + std::to_string(i) + "," + std::to_string(j) + "]", J[i][j].id()});
+      for (const Output& a : outputs("Jdot_qd", bias)) o.push_back(a);
+      out_.constraint_kinematics = merged(o, {}, o);
     }
     out_.position_constraints = merged(outputs("h", h), {}, outputs("h", h));
     out_.sensors = std::make_unique<EquationList>(symbolic::eliminate(with_outputs(*all_, outputs("s", sensors))));
@@ -864,14 +872,15 @@ class Generator {
   struct RelativeMotion {
     V3 omega, velocity, alpha, acc;
   };
-  RelativeMotion relative_motion(int k, int c) {
+  // `with_qdd` false: at qdd = 0 (the velocity-product terms, Jdot qd).
+  RelativeMotion relative_motion(int k, int c, bool with_qdd = true) {
     if (k == c) return {zero3(), zero3(), zero3(), zero3()};
-    const auto key = std::make_pair(k, c);
+    const auto key = std::make_tuple(k, c, with_qdd);
     if (const auto it = relative_motion_.find(key); it != relative_motion_.end()) return it->second;
     const Joint& j = m_.joints[k];
-    const RelativeMotion p = relative_motion(j.parent, c);
+    const RelativeMotion p = relative_motion(j.parent, c, with_qdd);
     const V3 r = offset_[k], e = joint_axis(k);
-    const Expr qd = ctx_->element(out_.qd, k), qdd = ctx_->element(out_.qdd, k);
+    const Expr qd = ctx_->element(out_.qd, k), qdd = with_qdd ? ctx_->element(out_.qdd, k) : ctx_->zero();
     const V3 wp = rotate_back(k, p.omega);
     V3 w = wp, v = rotate_back(k, p.velocity + cross(p.omega, r));
     V3 al = rotate_back(k, p.alpha);
@@ -883,22 +892,43 @@ class Generator {
       v = v + qd * e;
       a = a + qdd * e + 2.0 * qd * cross(wp, e);
     }
-    const std::string tag = "R" + std::to_string(c + 1) + "_";
+    const std::string tag = (with_qdd ? "R" : "RB") + std::to_string(c + 1) + "_";
     RelativeMotion m{assign("OM" + tag, k, w), assign("V" + tag, k, v), assign("OMP" + tag, k, al), assign("A" + tag, k, a)};
     return relative_motion_[key] = m;
   }
   // A point's velocity and acceleration relative to frame c (an ancestor of its body's frame, or
   // that frame), in c's components.
-  PointMotion relative_point_motion(PointRef p, int c) {
+  PointMotion relative_point_motion(PointRef p, int c, bool with_qdd = true) {
     const int f = m_.bodies[p.body].frame;
     if (f == c) return {zero3(), zero3()};
-    const RelativeMotion m = relative_motion(f, c);
+    const RelativeMotion m = relative_motion(f, c, with_qdd);
     const V3 r = anchor(p);
     const V3 wr = cross(m.omega, r);
     const V3 v = m.velocity + wr;
     const V3 a = m.acc + cross(m.alpha, r) + cross(m.omega, wr);
     const Rot rot = relative_placement(f, c).rot;
     return {rot.apply(v), rot.apply(a)};
+  }
+
+  // Jdot qd, the cut equations' second derivatives at qdd = 0, from the relative passes alone;
+  // empty when a cut needs the absolute one (a hinge, or a ball in ground components).
+  std::vector<Expr> constraint_bias() {
+    std::vector<Expr> rows;
+    int row = 0;
+    for (std::size_t ci = 0; ci < m_.cuts.size(); ++ci) {
+      const Cut& c = m_.cuts[ci];
+      const int frame = cut_frame(c);
+      if (frame < 0 || c.type == Cut::Type::Hinge) return {};
+      const PointMotion b = relative_point_motion(c.b, frame, false), a = relative_point_motion(c.a, frame, false);
+      const V3 da = b.acceleration - a.acceleration;
+      if (c.type == Cut::Type::Distance) {
+        const V3 dv = b.velocity - a.velocity;
+        rows.push_back(all_->assign("HB" + std::to_string(++row), (dot(dv, dv) + dot(cut_vector(ci), da)) * (1.0 / val(c.length))));
+      } else {
+        for (int comp : c.components) rows.push_back(all_->assign("HB" + std::to_string(++row), da[comp]));
+      }
+    }
+    return rows;
   }
 
   // The second time derivative of every cut equation, J qdd + Jdot qd, from the full pass's
@@ -1034,7 +1064,7 @@ class Generator {
   std::vector<Expr> cos_, sin_;
   std::vector<std::array<std::array<Expr, 3>, 3>> relative_rotation_;  // R of joints about arbitrary axes
   std::map<std::pair<int, int>, Placement> relative_;  // frame k relative to its ancestor c
-  std::map<std::pair<int, int>, RelativeMotion> relative_motion_;
+  std::map<std::tuple<int, int, bool>, RelativeMotion> relative_motion_;
   std::vector<V3> cut_vectors_;
   std::vector<Rot> rot_;
   std::vector<V3> origin_, offset_, omega_, velocity_, full_alpha_, full_acc_;

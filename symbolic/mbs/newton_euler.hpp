@@ -34,6 +34,10 @@ struct ModelLists {
   std::unique_ptr<symbolic::EquationList> constraints;
   // h (m), J qd (m): its tangent gives the dependent coordinates' and velocities' derivatives.
   std::unique_ptr<symbolic::EquationList> velocity_constraints;
+  // h (m), J (m x n), Jdot qd (m) in one list, Jdot qd from the loops' relative kinematics at
+  // qdd = 0: what the constraints cost together (dydp-gen --stats); null when a cut needs the
+  // absolute kinematics (a hinge, a ball in ground components).
+  std::unique_ptr<symbolic::EquationList> constraint_kinematics;
   // h (m) alone: its tangent gives dh for the dependent coordinates' derivatives.
   std::unique_ptr<symbolic::EquationList> position_constraints;
   std::unique_ptr<symbolic::EquationList> sensors;
