@@ -334,7 +334,7 @@ class Multibody : public Block {
 std::vector<engine::ParamSpec> exposed_parameters(const GeneratedModel& g) {
   std::vector<engine::ParamSpec> specs;
   for (int i = 0; i < g.parameters; ++i)
-    specs.push_back({g.parameter_names[i], "", g.parameter_values[i], false, -kInf, kInf, "model parameter"});
+    specs.push_back({g.parameter_names[i], g.parameter_units[i], g.parameter_values[i], false, -kInf, kInf, "model parameter"});
   ReducedDynamics reduced(g);
   for (int j : reduced.independent())
     specs.push_back({std::string("q0.") + g.coordinate_names[j], "m or rad", g.initial_q[j], false, -kInf, kInf,

@@ -81,11 +81,11 @@ w("# every body frame is parallel to it in the design position (all q = 0 but th
 w("model: sedan")
 w("gravity: [0, 0, -9.81]")
 w("parameters:")
-w("  chassis_mass: 1400.0       # [kg] sprung mass (A6 class)")
-w("  chassis_ixx: 550.0         # [kg m^2] about the centre of mass")
-w("  chassis_iyy: 2400.0")
-w("  chassis_izz: 2650.0")
-w("  wheel_mass: 21.103         # [kg] spindle (1.103) with wheel and tyre (20)")
+w("  chassis_mass: {value: 1400.0, unit: kg}       # sprung mass (A6 class)")
+w("  chassis_ixx: {value: 550.0, unit: kg m^2}     # about the centre of mass")
+w("  chassis_iyy: {value: 2400.0, unit: kg m^2}")
+w("  chassis_izz: {value: 2650.0, unit: kg m^2}")
+w("  wheel_mass: {value: 21.103, unit: kg}         # spindle (1.103) with wheel and tyre (20)")
 # Suspension geometry kept as symbols (sensitivity directions of the multibody block). Moving a
 # mount point holds the spring's free length and the sensors' design lengths: the car settles at
 # the ride height the new geometry gives, and the motion ratio changes with the lever.
@@ -93,10 +93,10 @@ STRUT_ARM_Y = front["strut_arm"][1] - front["lca_front"][1]
 SHOCK_ARM_X = rear["shock_arm"][0] - rear["tl_chassis"][0]
 SPRING_ARM_X = rear["spring_arm"][0] - rear["tl_chassis"][0]
 CHASSIS_COM_Z = 0.2
-w(f"  strut_arm_y_front: {STRUT_ARM_Y:.12g}   # [m] front strut's lower mount on the lower arm, outboard of its front pivot (mirrored right)")
-w(f"  shock_arm_x_rear: {SHOCK_ARM_X:.12g}  # [m] rear damper's lower mount on the trailing link, along x from its pivot (behind it)")
-w(f"  spring_arm_x_rear: {SPRING_ARM_X:.12g} # [m] rear spring's lower seat on the trailing link, along x from its pivot (behind it)")
-w(f"  chassis_com_height: {CHASSIS_COM_Z:.12g}  # [m] sprung mass's centre above the chassis frame (the cm sensor stays at 0.2)")
+w(f"  strut_arm_y_front: {{value: {STRUT_ARM_Y:.12g}, unit: m}}   # front strut's lower mount on the lower arm, outboard of its front pivot (mirrored right)")
+w(f"  shock_arm_x_rear: {{value: {SHOCK_ARM_X:.12g}, unit: m}}  # rear damper's lower mount on the trailing link, along x from its pivot (behind it)")
+w(f"  spring_arm_x_rear: {{value: {SPRING_ARM_X:.12g}, unit: m}} # rear spring's lower seat on the trailing link, along x from its pivot (behind it)")
+w(f"  chassis_com_height: {{value: {CHASSIS_COM_Z:.12g}, unit: m}}  # sprung mass's centre above the chassis frame (the cm sensor stays at 0.2)")
 w("bodies:")
 wheel_names = {"fl": "front left", "fr": "front right", "rl": "rear left", "rr": "rear right"}
 

@@ -69,6 +69,7 @@ struct GeneratedModel {
   const int* mass_rows;
   const int* mass_cols;
   GeneratedFunction mass_matrix;
+  const char* const* parameter_units;  // SI unit of each symbolic parameter ("" if the model gives none)
 };
 
 }  // namespace dydp::mbs

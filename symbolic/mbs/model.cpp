@@ -195,6 +195,7 @@ class Loader {
           if (!kv.second["value"]) fail(kv.second, field, "missing value");
           p.value = number(kv.second["value"], field + ".value");
           if (kv.second["fold"]) p.symbolic = !kv.second["fold"].as<bool>();
+          if (kv.second["unit"]) p.unit = text(kv.second["unit"], field + ".unit");
         } else {
           p.value = number(kv.second, field);
         }

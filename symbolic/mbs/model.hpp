@@ -22,6 +22,7 @@ struct Parameter {
   std::string name;
   double value = 0.0;
   bool symbolic = true;  // kept as a symbol (a sensitivity direction) or folded as a constant
+  std::string unit;      // SI unit as written (`kg`, `m`), empty if none was given
 };
 
 // R and T: about / along an arbitrary unit axis (Joint::axis) of the frame the joint starts from.
