@@ -31,8 +31,11 @@ using Vector = Eigen::VectorXd;
 // A-stable as well (gamma >= 1/4) and whose error constant on y' = lambda y is 34 times smaller
 // (1/6 - 3 gamma^2 + 2 gamma^3: -0.040 against 1.37), the same gamma as SDIRK2's.
 const double kGamma = 1.0 - 1.0 / std::sqrt(2.0);
-/// W is evaluated afresh after this many steps (a whole Jacobian costs tens of right-hand sides
-/// on the sedan; see docs/performance.md, 2026-12-02, for the choice).
+/// W is evaluated afresh after this many steps; in between, the diagonal blocks that blocks
+/// provide cheaply (Block::local_jacobian: the damper's pressures) are refreshed at every step.
+/// Without that, ROS2 is unstable on the damper's orifice laws at any step tried on the sedan
+/// (a linearised step overshoots where the flow goes as the square root of the pressure drop and
+/// the slope there moves within the step); docs/performance.md, 2026-12-02.
 const int kRefreshSteps = 50;
 /// A step whose embedded error estimate grows by more than this factor over the last step's
 /// (and exceeds kDivergenceFloor) while W is older than the step is taken again with W evaluated
@@ -101,16 +104,14 @@ class Ros2Stepper {
         accept(h, estimate);
         return;
       } catch (const StageFailure& failure) {
-        if (!fixed_ && age_ > 0) {  // a stale W first
-          refresh(t, x);
-          continue;
-        }
+        if (!fixed_ && age_ > 0 && refreshed(t, x)) continue;  // a stale W first
         if (halvings == kMaxHalvings)
           throw SolverError(failure.t, failure.block,
                             failure.why + " at a step of " + format_number(h) + " s (the scene's step " +
                                 format_number(scene_step) + " s halved " + std::to_string(kMaxHalvings) +
-                                " times): the solution changes faster than a fixed step can follow here; use "
-                                "method bdf, or a step of at most " + format_number(h) + " s");
+                                " times): a linearly implicit step cannot follow the solution here (and, without "
+                                "error control, the steps before may already have strayed); use method sdirk2 or "
+                                "bdf, or a smaller step for the whole run");
         ++stats_.substeps;
         advance(h / 2, halvings + 1, scene_step);
         advance(h / 2, halvings + 1, scene_step);
@@ -172,7 +173,34 @@ class Ros2Stepper {
     evaluator_at_start_ = true;
     last_estimate_ = estimate;
     ++stats_.steps;
-    if (!fixed_ && ++age_ >= kRefreshSteps) refresh(t, x);
+    if (fixed_) return;
+    if (++age_ >= kRefreshSteps) refresh(t, x);
+    else refresh_local(t, x);
+  }
+
+  /// The blocks' own diagonal blocks of W at (t, y), where blocks provide them (else nothing).
+  void refresh_local(double t_at, const Vector& y) {
+    if (!has_local_ || nx_ == 0) return;
+    try {
+      has_local_ = ev_.local_jacobians(t_at, y.data(), w_.data(), nx_);
+    } catch (const OutOfDomain& e) {
+      throw domain_failure(t_at, e);
+    }
+    if (!has_local_) return;
+    ++stats_.local_jac_evals;
+    factored_h_ = -1.0;
+    evaluator_at_start_ = false;
+  }
+
+  /// refresh(t, y), false when a block refuses the point.
+  bool refreshed(double t_at, const Vector& y) {
+    try {
+      refresh(t_at, y);
+      return true;
+    } catch (const SolverError&) {
+      age_ = 0;  // W as it was: halve instead
+      return false;
+    }
   }
 
   /// W = df/dx at (t, y), one tangent pass with the identity as state seeds.
@@ -234,6 +262,7 @@ class Ros2Stepper {
   int age_ = 0;                    ///< steps taken since W was evaluated
   double last_estimate_ = 0.0;     ///< the last accepted step's error estimate
   bool evaluator_at_start_ = false;  ///< the evaluator's last passes were at (t, x) with seeds S
+  bool has_local_ = true;            ///< some block provides a local Jacobian (until found otherwise)
   Vector scale_;
   Vector f_start_, f_end_, f_stage_, k1_, k2_, y_stage_, x_end_, g_start_, g_end_, g_stage_, q_end_;
   Matrix df_start_, df_end_, df_stage_, dk1_, dk2_, dy_stage_, s_end_, dg_start_, dg_end_, dg_stage_, sq_end_;
