@@ -22,7 +22,7 @@ struct TimeSpec {
 };
 
 struct SolverSpec {
-  std::string method = "bdf";  ///< bdf | adams | rk4 | sdirk2
+  std::string method = "bdf";  ///< bdf | adams | rk4 | sdirk2 | rosw
   double rtol = 1e-6;
   double atol = 1e-8;
   double step = 0.0;           ///< fixed-step methods; 0: output_step / 10

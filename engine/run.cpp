@@ -2,6 +2,7 @@
 
 #include "engine/cvodes_solver.hpp"
 #include "engine/rk4_solver.hpp"
+#include "engine/rosenbrock_solver.hpp"
 #include "engine/sdirk_solver.hpp"
 
 namespace dydp::engine {
@@ -21,6 +22,7 @@ int RunResult::signal_index(const std::string& name) const {
 RunResult run(const Diagram& d, const RunOptions& options) {
   RunResult r = d.solver.method == "rk4"      ? run_rk4(d, options)
                 : d.solver.method == "sdirk2" ? run_sdirk(d, options)
+                : d.solver.method == "rosw"   ? run_rosenbrock(d, options)
                                               : run_cvodes(d, options);
   // The load-time warnings first: what the input says, then what the run found.
   r.stats.warnings.insert(r.stats.warnings.begin(), d.warnings.begin(), d.warnings.end());

@@ -79,8 +79,9 @@ void read_solver(const SceneReader& r, const YAML::Node& n, const TimeSpec& time
   r.allow_keys(n, "solver", {"method", "rtol", "atol", "step", "max_steps", "min_step", "sens_error_test", "nominal_scaling"});
   if (n["method"]) {
     s.method = r.text(n["method"], "solver.method");
-    if (s.method != "bdf" && s.method != "adams" && s.method != "rk4" && s.method != "sdirk2")
-      r.fail(n["method"], "solver.method", "unknown method '" + s.method + "' (bdf, adams, rk4, sdirk2)");
+    if (s.method != "bdf" && s.method != "adams" && s.method != "rk4" && s.method != "sdirk2" &&
+        s.method != "rosw")
+      r.fail(n["method"], "solver.method", "unknown method '" + s.method + "' (bdf, adams, rk4, sdirk2, rosw)");
   }
   if (n["rtol"]) s.rtol = r.number(n["rtol"], "solver.rtol");
   if (n["atol"]) s.atol = r.number(n["atol"], "solver.atol");

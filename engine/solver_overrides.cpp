@@ -12,8 +12,9 @@ void apply_solver_overrides(Diagram& d, const SolverOverrides& o) {
     throw InputError(option, 0, "", message);
   };
   if (!o.method.empty()) {
-    if (o.method != "bdf" && o.method != "adams" && o.method != "rk4" && o.method != "sdirk2")
-      fail("--solver", "unknown method '" + o.method + "' (bdf, adams, rk4, sdirk2)");
+    if (o.method != "bdf" && o.method != "adams" && o.method != "rk4" && o.method != "sdirk2" &&
+        o.method != "rosw")
+      fail("--solver", "unknown method '" + o.method + "' (bdf, adams, rk4, sdirk2, rosw)");
     d.solver.method = o.method;
   }
   if (o.rtol) {

@@ -102,7 +102,7 @@ int accuracy_command(const AccuracyArgs& args) {
       const int column = std::string(what) == "objective" ? 10 : 11;
       gp << "set ylabel '" << what << " error (relative)'\nplot ";
       bool first = true;
-      for (const char* method : {"bdf", "adams", "rk4", "sdirk2"}) {
+      for (const char* method : {"bdf", "adams", "rk4", "sdirk2", "rosw"}) {
         gp << (first ? "" : ", ") << "'" << args.out << "/accuracy.csv' every ::1 using "
            << "(strcol(1) eq '" << method << "' && $3 == 1 ? $4 : 1/0):(($" << column << ") > 1e-16 ? $"
            << column << " : 1e-16) with linespoints title '" << method << "'";

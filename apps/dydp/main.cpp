@@ -15,7 +15,7 @@ namespace {
 
 /// --solver, --rtol, --atol, --step over the scene's solver section.
 void add_solver_options(CLI::App* command, dydp::engine::SolverOverrides& o) {
-  command->add_option("--solver", o.method, "integrator instead of the scene's (bdf adams rk4 sdirk2)");
+  command->add_option("--solver", o.method, "integrator instead of the scene's (bdf adams rk4 sdirk2 rosw)");
   command->add_option_function<double>("--rtol", [&o](const double& v) { o.rtol = v; }, "relative tolerance");
   command->add_option_function<double>(
       "--atol", [&o](const double& v) { o.atol = v; }, "absolute tolerance, times each state's nominal magnitude");
@@ -63,9 +63,9 @@ int main(int argc, char** argv) {
   accuracy->add_option("--out", accuracy_args.out, "output folder")->capture_default_str();
   accuracy->add_option("--set", accuracy_args.sets, "override a scene parameter: NAME=VALUE");
   accuracy->add_option("--target", accuracy_args.target, "accuracy for the cheapest-setting line")->capture_default_str();
-  accuracy->add_option("--methods", accuracy_args.methods, "methods of the ladder (bdf adams rk4 sdirk2)")
+  accuracy->add_option("--methods", accuracy_args.methods, "methods of the ladder (bdf adams rk4 sdirk2 rosw; default all but rosw)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"bdf", "adams", "rk4", "sdirk2"}))
+      ->check(CLI::IsMember({"bdf", "adams", "rk4", "sdirk2", "rosw"}))
       ->capture_default_str();
   add_solver_options(accuracy, accuracy_args.solver);
 

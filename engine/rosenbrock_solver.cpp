@@ -1,0 +1,338 @@
+#include "engine/rosenbrock_solver.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "engine/cpu_clock.hpp"
+#include "engine/errors.hpp"
+#include "engine/recorder.hpp"
+#include "engine/timeline.hpp"
+#include "engine/tolerances.hpp"
+
+namespace dydp::engine {
+namespace {
+
+using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic>;
+using Vector = Eigen::VectorXd;
+
+// ROS2 of J. G. Verwer, E. J. Spee, J. G. Blom, W. Hundsdorfer, "A second-order Rosenbrock
+// method applied to photochemical dispersion problems", SIAM J. Sci. Comput. 20(4), 1456-1480
+// (1999), section 2:
+//   (I - gamma h W) k1 = f(tn, yn)
+//   (I - gamma h W) k2 = f(tn + h, yn + h k1) - 2 k1
+//   y(n+1) = yn + 3/2 h k1 + 1/2 h k2.
+// Order 2 for any W and any gamma: expanding, k1 = f + gamma h W f + O(h^2) and
+// k2 = -f + h (J f + f_t) - 3 gamma h W f + O(h^2), so the W terms of 3/2 k1 + 1/2 k2 cancel and
+// y(n+1) = yn + h f + h^2/2 (J f + f_t) + O(h^3). With W = J its stability function is
+// R(z) = (1 + (1 - 2 gamma) z + (gamma^2 - 2 gamma + 1/2) z^2) / (1 - gamma z)^2, L-stable for
+// gamma = 1 +- 1/sqrt 2. The paper takes the + root (for positivity); here the - root, which is
+// A-stable as well (gamma >= 1/4) and whose error constant on y' = lambda y is 34 times smaller
+// (1/6 - 3 gamma^2 + 2 gamma^3: -0.040 against 1.37), the same gamma as SDIRK2's.
+const double kGamma = 1.0 - 1.0 / std::sqrt(2.0);
+/// W is evaluated afresh after this many steps; in between, the diagonal blocks that blocks
+/// provide cheaply (Block::local_jacobian: the damper's pressures) are refreshed at every step.
+/// Without that, ROS2 is unstable on the damper's orifice laws at any step tried on the sedan
+/// (a linearised step overshoots where the flow goes as the square root of the pressure drop and
+/// the slope there moves within the step); docs/performance.md, 2026-12-02.
+const int kRefreshSteps = 50;
+/// A step whose embedded error estimate grows by more than this factor over the last step's
+/// (and exceeds kDivergenceFloor) while W is older than the step is taken again with W evaluated
+/// at its start: a stale W on a stiff component shows as such a jump before it blows up.
+const double kDivergenceGrowth = 10.0;
+const double kDivergenceFloor = 1e-3;
+/// A step whose stage fails (non-finite value, state refused by a block) with a fresh W is taken
+/// as two of half the size, down to 1/2^this of the scene's step; then the run stops.
+const int kMaxHalvings = 6;
+
+/// A stage's value was not finite, or a block refused its state: the step is retried.
+struct StageFailure {
+  double t;
+  std::string block, why;
+};
+
+/// The scheme's state (x, q and their sensitivities S, Sq), W and its factorisation, and the
+/// start-of-step evaluations f(tn, xn), g(tn, xn) and their tangents, which the last step's
+/// end (or the record at an output time) already made.
+class Ros2Stepper {
+ public:
+  Ros2Stepper(const Diagram& d, Evaluator& ev, int ns, RunStats& stats, const std::vector<double>* fixed_w)
+      : ev_(ev), nx_(d.num_states), nq_(d.num_quadratures), ns_(ns), stats_(stats), fixed_(fixed_w != nullptr),
+        w_(nx_, nx_), identity_(Matrix::Identity(nx_, nx_)) {
+    const std::vector<double> nominal = state_nominals(d);
+    scale_ = Eigen::Map<const Vector>(nominal.data(), nx_);
+    if (fixed_) w_ = Eigen::Map<const Matrix>(fixed_w->data(), nx_, nx_);
+    const int nx1 = std::max(nx_, 1), nq1 = std::max(nq_, 1);
+    for (Vector* v : {&f_start_, &f_end_, &f_stage_, &k1_, &k2_, &y_stage_, &x_end_}) v->setZero(nx1);
+    for (Vector* v : {&g_start_, &g_end_, &g_stage_, &q_end_}) v->setZero(nq1);
+    for (Matrix* m : {&df_start_, &df_end_, &df_stage_, &dk1_, &dk2_, &dy_stage_, &s_end_}) m->setZero(nx_, ns_);
+    for (Matrix* m : {&dg_start_, &dg_end_, &dg_stage_, &sq_end_}) m->setZero(nq1, ns_);
+  }
+
+  double t = 0.0;
+  Vector x, q;
+  Matrix S, Sq;  ///< dx/dp (nx x ns), dq/dp (max(nq, 1) x ns)
+
+  /// Evaluates the first stage's right-hand side (and tangent) at (t, x): at the start and
+  /// after a breakpoint, where the right-hand side may jump. W is evaluated there too.
+  void begin() {
+    try {
+      evaluate(t, x, S, f_start_, g_start_, df_start_, dg_start_);
+    } catch (const StageFailure& e) {
+      throw SolverError(e.t, e.block, e.why);
+    }
+    if (!fixed_) refresh(t, x);
+  }
+
+  /// Leaves the evaluator's signals and tangents at (t, x) for the recorder.
+  void prepare_record() {
+    if (ns_ > 0 && !evaluator_at_start_) ev_.tangents(t, x.data(), ns_, {S.data(), nx_}, true, {}, {});
+    else ev_.outputs(t, x.data());
+    evaluator_at_start_ = true;
+  }
+
+  /// Advances by one step of size h, or by its halves when a stage fails.
+  void advance(double h, int halvings, double scene_step) {
+    for (;;) {
+      try {
+        const double estimate = attempt(h);
+        if (!fixed_ && age_ > 0 && estimate > kDivergenceFloor && estimate > kDivergenceGrowth * last_estimate_) {
+          refresh(t, x);  // and take the step again with W at its start
+          continue;
+        }
+        accept(h, estimate);
+        return;
+      } catch (const StageFailure& failure) {
+        if (!fixed_ && age_ > 0 && refreshed(t, x)) continue;  // a stale W first
+        if (halvings == kMaxHalvings)
+          throw SolverError(failure.t, failure.block,
+                            failure.why + " at a step of " + format_number(h) + " s (the scene's step " +
+                                format_number(scene_step) + " s halved " + std::to_string(kMaxHalvings) +
+                                " times): a linearly implicit step cannot follow the solution here (and, without "
+                                "error control, the steps before may already have strayed); use method sdirk2 or "
+                                "bdf, or a smaller step for the whole run");
+        ++stats_.substeps;
+        advance(h / 2, halvings + 1, scene_step);
+        advance(h / 2, halvings + 1, scene_step);
+        return;
+      }
+    }
+  }
+
+ private:
+  /// One step of ROS2 from (t, x) into x_end_ (q_end_, s_end_, sq_end_), with the next step's
+  /// first-stage evaluations at its end. Returns the embedded error estimate's weighted rms.
+  double attempt(double h) {
+    if (h != factored_h_) factor(h);
+    // Stage 1: k1 = M^-1 f(tn, xn);  dk1 = M^-1 (f_x S + f_p), W held constant.
+    solve(f_start_.head(nx_), k1_.head(nx_));
+    y_stage_.head(nx_) = x + h * k1_.head(nx_);
+    if (ns_ > 0) {
+      solve(df_start_, dk1_);
+      dy_stage_ = S + h * dk1_;
+    }
+    // Stage 2 at (tn + h, xn + h k1): k2 = M^-1 (f - 2 k1), and its tangent likewise.
+    const double t_end = t + h;
+    evaluate(t_end, y_stage_.head(nx_), dy_stage_, f_stage_, g_stage_, df_stage_, dg_stage_);
+    f_stage_.head(nx_) -= 2 * k1_.head(nx_);
+    solve(f_stage_.head(nx_), k2_.head(nx_));
+    x_end_.head(nx_) = x + h * (1.5 * k1_.head(nx_) + 0.5 * k2_.head(nx_));
+    // The quadratures see W = 0 in their rows: the trapezoidal rule over the two stage points.
+    q_end_.head(nq_) = q + 0.5 * h * (g_start_.head(nq_) + g_stage_.head(nq_));
+    if (ns_ > 0) {
+      df_stage_ -= 2 * dk1_;
+      solve(df_stage_, dk2_);
+      s_end_ = S + h * (1.5 * dk1_ + 0.5 * dk2_);
+      sq_end_.topRows(nq_) = Sq.topRows(nq_) + 0.5 * h * (dg_start_.topRows(nq_) + dg_stage_.topRows(nq_));
+    }
+    // The next step's first stage, at the new state: a value a block refuses fails this step.
+    evaluate(t_end, x_end_.head(nx_), s_end_, f_end_, g_end_, df_end_, dg_end_);
+    // Embedded first-order solution xn + h k1: x(n+1) minus it is h/2 (k1 + k2), weighted by
+    // the states' nominal magnitudes (or their values, where larger).
+    if (nx_ == 0) return 0.0;
+    const Vector weight = scale_.cwiseMax(x_end_.head(nx_).cwiseAbs());
+    const Vector error = (0.5 * h * (k1_.head(nx_) + k2_.head(nx_))).cwiseQuotient(weight);
+    return std::sqrt(error.squaredNorm() / nx_);
+  }
+
+  void accept(double h, double estimate) {
+    t += h;
+    x.swap(x_end_);
+    x_end_.resize(std::max(nx_, 1));
+    x.conservativeResize(nx_);
+    q = q_end_.head(nq_);
+    std::swap(f_start_, f_end_);
+    std::swap(g_start_, g_end_);
+    if (ns_ > 0) {
+      std::swap(S, s_end_);
+      std::swap(df_start_, df_end_);
+      std::swap(dg_start_, dg_end_);
+      Sq.topRows(nq_) = sq_end_.topRows(nq_);
+    }
+    evaluator_at_start_ = true;
+    last_estimate_ = estimate;
+    ++stats_.steps;
+    if (fixed_) return;
+    if (++age_ >= kRefreshSteps) refresh(t, x);
+    else refresh_local(t, x);
+  }
+
+  /// The blocks' own diagonal blocks of W at (t, y), where blocks provide them (else nothing).
+  void refresh_local(double t_at, const Vector& y) {
+    if (!has_local_ || nx_ == 0) return;
+    try {
+      has_local_ = ev_.local_jacobians(t_at, y.data(), w_.data(), nx_);
+    } catch (const OutOfDomain& e) {
+      throw domain_failure(t_at, e);
+    }
+    if (!has_local_) return;
+    ++stats_.local_jac_evals;
+    factored_h_ = -1.0;
+    evaluator_at_start_ = false;
+  }
+
+  /// refresh(t, y), false when a block refuses the point.
+  bool refreshed(double t_at, const Vector& y) {
+    try {
+      refresh(t_at, y);
+      return true;
+    } catch (const SolverError&) {
+      age_ = 0;  // W as it was: halve instead
+      return false;
+    }
+  }
+
+  /// W = df/dx at (t, y), one tangent pass with the identity as state seeds.
+  void refresh(double t_at, const Vector& y) {
+    if (nx_ == 0) return;
+    try {
+      ev_.tangents(t_at, y.data(), nx_, {identity_.data(), nx_}, false, {w_.data(), nx_}, {});
+    } catch (const OutOfDomain& e) {
+      throw domain_failure(t_at, e);
+    }
+    ++stats_.jac_evals;
+    factored_h_ = -1.0;
+    age_ = 0;
+    evaluator_at_start_ = false;
+  }
+
+  void factor(double h) {
+    if (nx_ > 0) lu_.compute(identity_ - kGamma * h * w_);
+    factored_h_ = h;
+  }
+
+  /// out = (I - gamma h W)^-1 rhs (nothing to solve without states).
+  template <class Rhs, class Out>
+  void solve(const Rhs& rhs, Out&& out) const {
+    if (nx_ > 0) out = lu_.solve(rhs);
+  }
+
+  /// f(t, y) and g(t, y) and, with sensitivities, their tangents for the state seeds dy.
+  void evaluate(double t_at, const Eigen::Ref<const Vector>& y, const Matrix& dy, Vector& f, Vector& g, Matrix& df,
+                Matrix& dg) {
+    try {
+      ev_.derivatives(t_at, y.data(), f.data());
+      if (nq_ > 0) ev_.quadratures(t_at, y.data(), g.data());
+      ++stats_.rhs_evals;
+      if (!ev_.all_finite(f.data())) {
+        const std::string bad = ev_.find_nonfinite(f.data());
+        const auto colon = bad.find(':');
+        throw StageFailure{t_at, bad.substr(0, colon), colon == std::string::npos ? bad : bad.substr(colon + 2)};
+      }
+      if (ns_ > 0) {
+        ev_.tangents(t_at, y.data(), ns_, {dy.data(), nx_}, true, {df.data(), nx_}, {nq_ ? dg.data() : nullptr, nq_});
+        ++stats_.sens_rhs_evals;
+      }
+    } catch (const OutOfDomain& e) {
+      const auto colon = e.reason.find(": ");
+      if (colon == std::string::npos) throw StageFailure{t_at, "", "input out of a block's domain: " + e.reason};
+      throw StageFailure{t_at, e.reason.substr(0, colon),
+                         "input out of the block's domain: " + e.reason.substr(colon + 2)};
+    }
+  }
+
+  Evaluator& ev_;
+  int nx_, nq_, ns_;
+  RunStats& stats_;
+  bool fixed_;
+  Matrix w_, identity_;
+  Eigen::PartialPivLU<Matrix> lu_;
+  double factored_h_ = -1.0;
+  int age_ = 0;                    ///< steps taken since W was evaluated
+  double last_estimate_ = 0.0;     ///< the last accepted step's error estimate
+  bool evaluator_at_start_ = false;  ///< the evaluator's last passes were at (t, x) with seeds S
+  bool has_local_ = true;            ///< some block provides a local Jacobian (until found otherwise)
+  Vector scale_;
+  Vector f_start_, f_end_, f_stage_, k1_, k2_, y_stage_, x_end_, g_start_, g_end_, g_stage_, q_end_;
+  Matrix df_start_, df_end_, df_stage_, dk1_, dk2_, dy_stage_, s_end_, dg_start_, dg_end_, dg_stage_, sq_end_;
+};
+
+RunResult run_ros2(const Diagram& d, const RunOptions& options, const std::vector<double>* fixed_w) {
+  const int nx = d.num_states, nq = d.num_quadratures;
+  const int ns = options.sensitivities ? static_cast<int>(d.sensitivities.size()) : 0;
+  const double t0 = d.time.start;
+  const double h_max = d.solver.step > 0 ? d.solver.step : d.time.output_step / 10.0;
+  if (fixed_w && fixed_w->size() != static_cast<size_t>(nx) * nx)
+    throw SolverError(t0, "", "the given W has " + std::to_string(fixed_w->size()) + " elements, not " +
+                                  std::to_string(nx) + " x " + std::to_string(nx));
+
+  Evaluator ev(d, ns > 0);
+  RunResult result;
+  Recorder recorder(d, ns, result, options);
+  RunStats& st = result.stats;
+  const CpuClock clock;
+  Ros2Stepper stepper(d, ev, ns, st, fixed_w);
+
+  stepper.t = t0;
+  stepper.x.setZero(std::max(nx, 1));
+  ev.set_segment_start(t0);
+  ev.initial_state(t0, stepper.x.data());
+  stepper.x.conservativeResize(nx);
+  stepper.q.setZero(nq);
+  stepper.S.setZero(nx, ns);
+  stepper.Sq.setZero(std::max(nq, 1), ns);
+  if (ns > 0) ev.initial_state_tangent(t0, stepper.x.data(), {stepper.S.data(), nx});
+  stepper.begin();
+
+  auto record = [&](double t) {
+    stepper.prepare_record();
+    recorder.record(t, stepper.x.data(), ev);
+  };
+  record(t0);
+
+  const Timeline timeline(d);
+  double t = t0;
+  for (double target : timeline.events) {
+    const long n = fixed_steps(t, target, h_max);
+    const double h = (target - t) / n;
+    for (long step = 0; step < n; ++step) {
+      stepper.t = t + step * h;
+      stepper.advance(h, 0, h_max);
+    }
+    t = stepper.t = target;
+    if (timeline.is_output(target)) record(target);
+    if (timeline.is_break(target)) {
+      ev.set_segment_start(target);
+      stepper.begin();  // the right-hand side may jump here
+    }
+  }
+  Vector qf = Vector::Zero(std::max(nq, 1));
+  qf.head(nq) = stepper.q;
+  recorder.finish(qf.data(), {stepper.Sq.data(), static_cast<int>(stepper.Sq.rows())});
+  result.final_state.assign(stepper.x.data(), stepper.x.data() + nx);
+
+  st.step = h_max;
+  finish_stats(st, "rosw", clock.seconds(), d.time);
+  return result;
+}
+
+}  // namespace
+
+RunResult run_rosenbrock(const Diagram& d, const RunOptions& options) { return run_ros2(d, options, nullptr); }
+
+RunResult run_rosenbrock_fixed_w(const Diagram& d, const RunOptions& options, const std::vector<double>& w) {
+  return run_ros2(d, options, &w);
+}
+
+}  // namespace dydp::engine
