@@ -413,7 +413,7 @@ QString SceneController::set_time(const QString& key, const QString& text) {
 
 QString SceneController::set_solver(const QString& key, const QString& text) {
   if (key == "method") {
-    static const QStringList methods = {"bdf", "adams", "rk4", "sdirk2"};
+    static const QStringList methods = {"bdf", "adams", "rk4", "sdirk2", "rosw"};
     if (!text.isEmpty() && !methods.contains(text))
       return tr("solver.method: unknown method '%1' (%2)").arg(text, methods.join(", "));
   } else if (key == "sens_error_test") {

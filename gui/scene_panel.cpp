@@ -47,8 +47,8 @@ ScenePanel::ScenePanel(SceneController* controller, QWidget* parent)
   auto* solver_box = new QGroupBox(tr("Solver"));
   auto* solver_form = new QFormLayout(solver_box);
   method_ = new QComboBox;
-  method_->addItems({"", "bdf", "adams", "rk4", "sdirk2"});
-  method_->setToolTip(tr("bdf: stiff scenes; adams: non-stiff; rk4, sdirk2: fixed step (empty: bdf)"));
+  method_->addItems({"", "bdf", "adams", "rk4", "sdirk2", "rosw"});
+  method_->setToolTip(tr("bdf: stiff scenes; adams: non-stiff; rk4, sdirk2, rosw: fixed step (empty: bdf)"));
   solver_form->addRow("method", method_);
   connect(method_, &QComboBox::currentTextChanged, this, [this](const QString& m) {
     if (!refreshing_) report(controller_->set_solver("method", m));
