@@ -278,7 +278,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   // One step at a time, so that after each accepted step the state with the largest weighted
   // local error is counted (StepLimiters); outputs are interpolated (CVodeGetDky) as CVODES'
   // normal mode does, from the same steps.
-  StepLimiters limiters(nx);
+  StepLimiters limiters(nx + nq);
   N_Vector local_errors = N_VClone(S.y), weights = N_VClone(S.y);
   struct Release {
     N_Vector a, b;
@@ -329,7 +329,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
                  " steps taken before reaching the next output time " + format_number(target) + " s)");
       const int flag = CVode(S.mem, target, S.y, &reached, CV_ONE_STEP);
       if (flag < 0) fail(flag, reached, std::string("CVode failed: ") + CVodeGetReturnFlagName(flag));
-      if (nx > 0 && CVodeGetEstLocalErrors(S.mem, local_errors) == CV_SUCCESS &&
+      if (nx + nq > 0 && CVodeGetEstLocalErrors(S.mem, local_errors) == CV_SUCCESS &&
           CVodeGetErrWeights(S.mem, weights) == CV_SUCCESS)
         limiters.add_step(NV_DATA_S(local_errors), NV_DATA_S(weights));
       at_target = reached == target;

@@ -18,6 +18,11 @@ std::string state_label(const Diagram& d, int i) {
   for (const Node& n : d.nodes)
     if (i >= n.state_offset && i < n.state_offset + n.block->num_states())
       return n.name + "." + n.block->state_names()[i - n.state_offset];
+  // past the states: the objective integrals, which CVODES integrates with them ([x; q])
+  const int k = i - d.num_states;
+  for (const Node& n : d.nodes)
+    if (k >= n.quad_offset && k < n.quad_offset + n.block->num_quadratures())
+      return n.name + ".integral" + (n.block->num_quadratures() > 1 ? std::to_string(k - n.quad_offset) : "");
   return "state " + std::to_string(i);
 }
 

@@ -170,6 +170,31 @@ TEST_F(ErrorControl, TheFastOscillatorLimitsTheStepUntilTheSlowOneIsHeldTighter)
   EXPECT_NE(json.find("\"state\": \"" + both.stats.limiting_states[0].state + "\""), std::string::npos);
 }
 
+TEST_F(ErrorControl, AnObjectiveIntegralThatLimitsTheStepIsNamed) {
+  // The slow oscillator beside the rms of a 4 Hz sine: the integral of sin^2 varies at 8 Hz, so
+  // at equal absolute tolerances its local error is the largest, and it is named as
+  // `block.integral` among the limiting states.
+  const std::string path = write("integral.yaml",
+                                 "scene: integral\n"
+                                 "time: {stop: 2.0, output_step: 0.05}\n"
+                                 "solver: {method: bdf, rtol: 1.0e-13, atol: 1.0e-6}\n"
+                                 "blocks:\n"
+                                 "  zero: {type: source.constant, value: 0.0}\n"
+                                 "  slow: {type: mass_spring_damper, m: 1.0, k: 1.0, x0: 1.0}\n"
+                                 "  wave: {type: source.sine, amplitude: 1.0, frequency: 4.0}\n"
+                                 "  wave_rms: {type: objective.rms, window: [0.0, 2.0]}\n"
+                                 "connections:\n"
+                                 "  - zero.y -> slow.f\n"
+                                 "  - wave.y -> wave_rms.in\n"
+                                 "outputs: [slow.x, wave_rms]\n");
+  const Diagram d = load_scene(path);
+  const RunResult r = run(d);
+  ASSERT_FALSE(r.stats.limiting_states.empty());
+  EXPECT_EQ(r.stats.limiting_states[0].state.rfind("wave_rms.integral", 0), 0u) << r.stats.limiting_states[0].state;
+  EXPECT_GT(r.stats.limiting_states[0].share, 0.5);
+  EXPECT_EQ(state_label(d, d.num_states), r.stats.limiting_states[0].state);
+}
+
 TEST_F(ErrorControl, BadNominalsAreRefusedWithFileLineAndField) {
   auto expect_refused = [&](const std::string& nominal, const std::string& field, const std::string& phrase) {
     const std::string path = write("bad.yaml",
