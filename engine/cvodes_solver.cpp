@@ -201,6 +201,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   check(sv_flag, "CVodeSVtolerances");
   check(CVodeSetMaxNumSteps(S.mem, d.solver.max_steps), "CVodeSetMaxNumSteps");
   check(CVodeSetMinStep(S.mem, d.solver.min_step), "CVodeSetMinStep");
+  check(CVodeSetNonlinConvCoef(S.mem, d.solver.newton_coefficient), "CVodeSetNonlinConvCoef");
   if (bdf) {
     S.A = SUNDenseMatrix(n_cv, n_cv, S.ctx);
     S.LS = make_dense_lu_solver(S.ctx, n_cv);

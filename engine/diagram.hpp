@@ -36,6 +36,10 @@ struct SolverSpec {
   /// Absolute tolerances scaled by the states' nominal magnitudes (atol * nominal_i); false:
   /// atol as it stands for every state, the nominal magnitudes ignored.
   bool nominal_scaling = true;
+  /// BDF and Adams: the Newton iteration's convergence test, as a fraction of the error test's
+  /// tolerance (CVODES' nonlinear convergence coefficient, its default 0.1). A larger value
+  /// stops the iteration sooner and declares fewer convergence failures (each costs a Jacobian).
+  double newton_coefficient = 0.1;
 };
 
 struct SceneParameter {

@@ -78,6 +78,7 @@ std::string run_json(const Diagram& d, const RunResult& r) {
       {"fixed_step", s.step},
       {"sens_error_test", d.solver.sens_error_test},
       {"nominal_scaling", d.solver.nominal_scaling},
+      {"newton_coefficient", d.solver.newton_coefficient},
       {"parameters", parameters},
       {"sensitivities", r.sensitivity_names},
       {"states", d.num_states},

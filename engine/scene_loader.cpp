@@ -76,7 +76,9 @@ void read_time(const SceneReader& r, const YAML::Node& n, TimeSpec& time) {
 
 void read_solver(const SceneReader& r, const YAML::Node& n, const TimeSpec& time, SolverSpec& s) {
   if (!n) return check_solver_relations(r.file(), n, s, time);
-  r.allow_keys(n, "solver", {"method", "rtol", "atol", "step", "max_steps", "min_step", "sens_error_test", "nominal_scaling"});
+  r.allow_keys(n, "solver",
+               {"method", "rtol", "atol", "step", "max_steps", "min_step", "sens_error_test", "nominal_scaling",
+                "newton_coefficient"});
   if (n["method"]) {
     s.method = r.text(n["method"], "solver.method");
     if (s.method != "bdf" && s.method != "adams" && s.method != "rk4" && s.method != "sdirk2" &&
@@ -104,6 +106,9 @@ void read_solver(const SceneReader& r, const YAML::Node& n, const TimeSpec& time
     s.max_steps = static_cast<long>(v);
   }
   if (n["min_step"]) s.min_step = r.number(n["min_step"], "solver.min_step");
+  if (n["newton_coefficient"]) s.newton_coefficient = r.number(n["newton_coefficient"], "solver.newton_coefficient");
+  if (!(s.newton_coefficient > 0 && s.newton_coefficient <= 1))
+    r.fail(n["newton_coefficient"], "solver.newton_coefficient", "must be in (0, 1]");
   if (!(s.min_step >= 0)) r.fail(n["min_step"], "solver.min_step", "must not be negative");
   if (!(s.rtol > 0)) r.fail(n["rtol"], "solver.rtol", "must be positive");
   if (!(s.atol > 0)) r.fail(n["atol"], "solver.atol", "must be positive");

@@ -195,6 +195,24 @@ TEST_F(ErrorControl, AnObjectiveIntegralThatLimitsTheStepIsNamed) {
   EXPECT_EQ(state_label(d, d.num_states), r.stats.limiting_states[0].state);
 }
 
+TEST_F(ErrorControl, ALargerNewtonCoefficientReachesCvodesAndStopsTheIterationSooner) {
+  // The quarter car with its CDC damper: a looser Newton test (0.5 against CVODES' 0.1) takes
+  // fewer corrector iterations per step and fails fewer times; run.json records the setting.
+  const std::string scenes = std::string(DYDP_SOURCE_DIR) + "/scenarios/";
+  Diagram strict = load_scene(scenes + "quarter_car_cdc.yaml");
+  Diagram loose = load_scene(scenes + "quarter_car_cdc.yaml");
+  strict.time.stop = loose.time.stop = 3.0;
+  EXPECT_EQ(strict.solver.newton_coefficient, 0.1);
+  loose.solver.newton_coefficient = 0.5;
+  RunOptions options;
+  options.sensitivities = false;
+  const RunResult a = run(strict, options), b = run(loose, options);
+  EXPECT_LT(static_cast<double>(b.stats.nonlinear_iterations) / b.stats.steps,
+            static_cast<double>(a.stats.nonlinear_iterations) / a.stats.steps);
+  EXPECT_LE(b.stats.nonlinear_failures, a.stats.nonlinear_failures);
+  EXPECT_NE(run_json(loose, b).find("\"newton_coefficient\": 0.5"), std::string::npos);
+}
+
 TEST_F(ErrorControl, BadNominalsAreRefusedWithFileLineAndField) {
   auto expect_refused = [&](const std::string& nominal, const std::string& field, const std::string& phrase) {
     const std::string path = write("bad.yaml",

@@ -608,6 +608,13 @@ TEST_F(SceneValidation, NegativeMinStep) {
   expect_error(load_error(path), path, 5, "solver.min_step", "must not be negative");
 }
 
+TEST_F(SceneValidation, NewtonCoefficientOutsideTheUnitInterval) {
+  for (const char* value : {"0.0", "-0.1", "1.5"}) {
+    const std::string path = write("s.yaml", scene_with_solver_setting(std::string("newton_coefficient: ") + value));
+    expect_error(load_error(path), path, 5, "solver.newton_coefficient", "must be in (0, 1]");
+  }
+}
+
 TEST_F(SceneValidation, MalformedCsvTableNamesTheCsvFileAndRow) {
   const std::string csv = write("road.csv", "t,z\n0.0,0.0\n0.5,0.01\n1.0,abc\n");
   const std::string path = write("s.yaml", R"(scene: t
