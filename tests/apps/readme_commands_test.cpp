@@ -1,9 +1,11 @@
 // The commands of README.md "Using dydp", each run as written there: the main job
-// (scenarios/fourposter_comfort.yaml) with --report, `sweep --report`, `accuracy --methods`.
+// (scenarios/fourposter_comfort.yaml) with --report, `sweep --report`, `accuracy --methods`,
+// the handling scene's `screen` (with fewer samples).
 // (`replay` with its sensitivities is tests/apps/replay_values_test.cpp.) A report is checked
 // for what it promises: report.md is not empty and every plot it shows exists and is not empty.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -115,6 +117,41 @@ TEST_F(ReadmeCommands, AccuracyWithMethods) {
   EXPECT_EQ(other, 0);
   EXPECT_GT(fs::file_size(out / "accuracy.md"), 0u);
   EXPECT_NE(r.out.find("Cheapest setting for errors below 0.0001"), std::string::npos) << r.out;
+}
+
+// The README's screening command on the handling scene, as README.md writes it (read from the
+// file), with 2 samples instead of 16: every listed parameter is ranked for every objective,
+// the front and rear bars lead the yaw rate (steady-state handling is roll stiffness
+// distribution), and the report shows its tornado charts.
+TEST_F(ReadmeCommands, ScreenOfTheHandlingScene) {
+  const std::string readme = read_text(source_path("README.md"));
+  const std::string prefix = "dydp screen scenarios/cornering_arb.yaml";
+  const std::size_t at = readme.find(prefix);
+  ASSERT_NE(at, std::string::npos) << "README.md has no " << prefix;
+  std::string command = readme.substr(at + 5, readme.find('\n', at) - at - 5);
+  command = replaced(command, "scenarios/cornering_arb.yaml", quote(source_path("scenarios/cornering_arb.yaml").string()));
+  command = replaced(command, "--samples 16", "--samples 2");
+  const fs::path out = dir_ / "screen";
+  command = replaced(command, "--out out/screen_cornering", "--out " + quote(out.string()));
+  const std::string listed = command.substr(command.find("--params ") + 9);
+  const std::size_t parameters = static_cast<std::size_t>(std::count(listed.begin(), listed.end(), ',')) + 1;
+  EXPECT_GE(parameters, 16u);
+
+  const ProcessResult r = dydp(command);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(read_text(out / "screen.json"));
+  for (const char* objective : {"beta", "yaw_rate", "lateral_acc", "roll"}) {
+    SCOPED_TRACE(objective);
+    ASSERT_TRUE(j["objectives"].contains(objective)) << j.dump();
+    const json& ranking = j["objectives"][objective]["parameters"];
+    ASSERT_EQ(ranking.size(), parameters);
+  }
+  const json& yaw = j["objectives"]["yaw_rate"]["parameters"];
+  std::set<std::string> top;
+  for (const auto& [name, p] : yaw.items())
+    if (p["rank"].get<int>() <= 2) top.insert(name);
+  EXPECT_EQ(top, (std::set<std::string>{"arb_front", "arb_rear"})) << yaw.dump();
+  check_report(out);
 }
 
 }  // namespace
