@@ -375,7 +375,7 @@ class Generator {
     // point's body frame by the relative rotation when `frame` is an ancestor (for a spring
     // between chassis and wishbone, one joint's rotation) instead of through the ground.
     // Forces are summed per point of application (the tyre's three components at its contact
-    // point, the cut forces at a ball joint) and their moment taken once (point_moments below).
+    // point, the cut forces at a ball joint) and their moment taken once, after every load.
     std::map<std::pair<int, int>, V3> point_force;
     auto apply_in = [&](PointRef p, int frame, const V3& force) {
       if (p.body == 0) return;
