@@ -18,6 +18,7 @@
 #include "engine/csv.hpp"
 #include "tests/apps/dydp_process.hpp"
 #include "tests/engine/msd_closed_form.hpp"
+#include "tests/grid_error.hpp"
 
 namespace dydp::test {
 namespace {
@@ -42,17 +43,6 @@ Complex rms_of(const MsdParams<Complex>& p) {
 }
 double rms_value(const MsdParams<double>& p) {
   return rms_of({p.m, p.k, p.c, p.amplitude, p.omega, p.x0, p.v0}).real();
-}
-
-/// Worst difference of a column from the reference over the grid, relative to the reference's
-/// largest magnitude.
-double grid_error(const std::vector<double>& values, const std::vector<double>& reference) {
-  double worst = 0, scale = 0;
-  for (size_t k = 0; k < values.size(); ++k) {
-    worst = std::max(worst, std::fabs(values[k] - reference[k]));
-    scale = std::max(scale, std::fabs(reference[k]));
-  }
-  return worst / scale;
 }
 
 class CliValues : public DydpProcessTest {

@@ -17,6 +17,7 @@
 
 #include "engine/csv.hpp"
 #include "tests/apps/dydp_process.hpp"
+#include "tests/grid_error.hpp"
 
 namespace dydp::test {
 namespace {
@@ -81,15 +82,6 @@ std::string sine_scene(double output_step) {
          "connections:\n" + kBodyConnections;
 }
 
-double worst_relative(const std::vector<double>& a, const std::vector<double>& b) {
-  double worst = 0, scale = 0;
-  for (size_t k = 0; k < a.size(); ++k) {
-    worst = std::max(worst, std::fabs(a[k] - b[k]));
-    scale = std::max(scale, std::fabs(b[k]));
-  }
-  return worst / scale;
-}
-
 class ReplayValues : public DydpProcessTest {
  protected:
   ReplayValues() : DydpProcessTest("dydp_replay_values_") {}
@@ -148,10 +140,10 @@ TEST_F(ReplayValues, ReplayFollowsTheRecordingNotTheRig) {
   const engine::CsvFile independent = engine::read_csv((sines / "signals.csv").string());
   ASSERT_EQ(column(independent, "t").size(), t.size());
   for (const std::string body : {"body_front.x", "body_rear.x"}) {
-    EXPECT_LT(worst_relative(column(replayed, body), column(independent, body)), 1e-4) << body;
+    EXPECT_LT(grid_error(column(replayed, body), column(independent, body)), 1e-4) << body;
     for (const std::string p : {"stiffness", "damping"}) {
       const std::string name = "d(" + body + ")/d(" + p + ")";
-      EXPECT_LT(worst_relative(column(replayed, name), column(independent, name)), 1e-4) << name;
+      EXPECT_LT(grid_error(column(replayed, name), column(independent, name)), 1e-4) << name;
     }
   }
 

@@ -16,9 +16,12 @@
 #include "engine/run.hpp"
 #include "engine/timeline.hpp"
 #include "tests/engine/msd_closed_form.hpp"
+#include "tests/grid_error.hpp"
 
 namespace dydp::engine {
 namespace {
+
+using test::grid_error;
 
 const std::string kScene = std::string(DYDP_SOURCE_DIR) + "/scenarios/msd_sensitivity.yaml";
 constexpr double kWindowFrom = 2.0, kWindowTo = 10.0;
@@ -51,15 +54,6 @@ std::vector<double> initial_jacobian(const Diagram& d) {
   ev.initial_state(d.time.start, x.data());
   ev.tangents(d.time.start, x.data(), nx, {identity.data(), nx}, false, {jac.data(), nx}, {});
   return jac;
-}
-
-double grid_error(const std::vector<double>& a, const std::vector<double>& b) {
-  double err = 0, scale = 0;
-  for (size_t k = 0; k < a.size(); ++k) {
-    err = std::max(err, std::fabs(a[k] - b[k]));
-    scale = std::max(scale, std::fabs(b[k]));
-  }
-  return err / scale;
 }
 
 std::vector<double> signal(const RunResult& r, int i) {
