@@ -2,11 +2,11 @@
 // `layout:` section opened in the window is drawn with every source (a block without inputs)
 // left of every objective and no two blocks overlapping; Edit > Lay out diagram (Ctrl+L) lays
 // out a scene that has a layout the same way, as one undo step; crossing wires are uncrossed.
-#include <QDirIterator>
 #include <QFile>
 #include <QtTest>
 
 #include "gui/main_window.hpp"
+#include "gui/tests/shipped_scenes.hpp"
 
 using namespace dydp::gui;
 
@@ -58,12 +58,10 @@ class GuiLayout : public QObject {
  private slots:
   void scenes_without_layout_are_layered_data() {
     QTest::addColumn<QString>("path");
-    QDirIterator it(DYDP_SCENARIOS_DIR, {"*.yaml"}, QDir::Files, QDirIterator::Subdirectories);
     int n = 0;
-    while (it.hasNext()) {
-      const QString path = it.next();
-      if (QFileInfo(path).dir().dirName() == "subsystems" || has_layout_section(path)) continue;
-      QTest::newRow(QDir(DYDP_SCENARIOS_DIR).relativeFilePath(path).toUtf8().constData()) << path;
+    for (const QString& path : testing::shipped_scenes()) {
+      if (has_layout_section(path)) continue;
+      QTest::newRow(testing::scene_row_name(path).constData()) << path;
       ++n;
     }
     QVERIFY(n >= 10);  // six scenes of scenarios/ and the eight stress scenes have none today

@@ -2,13 +2,12 @@
 // window, fitted, and every block inside the visible part of the view; the scene rectangle
 // holds the diagram however large; a subsystem instance opened by a double-click on the canvas,
 // its inside fitted, and the breadcrumb back to the scene.
-#include <QDir>
-#include <QDirIterator>
 #include <QLabel>
 #include <QScrollBar>
 #include <QtTest>
 
 #include "gui/main_window.hpp"
+#include "gui/tests/shipped_scenes.hpp"
 
 using namespace dydp::gui;
 
@@ -46,12 +45,9 @@ class GuiViews : public QObject {
  private slots:
   void every_scene_fits_in_the_view_data() {
     QTest::addColumn<QString>("path");
-    QDirIterator it(DYDP_SCENARIOS_DIR, {"*.yaml"}, QDir::Files, QDirIterator::Subdirectories);
     int n = 0;
-    while (it.hasNext()) {
-      const QString path = it.next();
-      if (QFileInfo(path).dir().dirName() == "subsystems") continue;  // included by scenes, not scenes
-      QTest::newRow(QDir(DYDP_SCENARIOS_DIR).relativeFilePath(path).toUtf8().constData()) << path;
+    for (const QString& path : testing::shipped_scenes()) {
+      QTest::newRow(testing::scene_row_name(path).constData()) << path;
       ++n;
     }
     QVERIFY(n >= 15);
