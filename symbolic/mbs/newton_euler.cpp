@@ -917,18 +917,28 @@ class Generator {
     int row = 0;
     for (std::size_t ci = 0; ci < m_.cuts.size(); ++ci) {
       const Cut& c = m_.cuts[ci];
-      const int frame = cut_frame(c);
-      if (frame < 0 || c.type == Cut::Type::Hinge) return {};
-      const PointMotion b = relative_point_motion(c.b, frame, false), a = relative_point_motion(c.a, frame, false);
-      const V3 da = b.acceleration - a.acceleration;
-      if (c.type == Cut::Type::Distance) {
-        const V3 dv = b.velocity - a.velocity;
-        rows.push_back(all_->assign("HB" + std::to_string(++row), (dot(dv, dv) + dot(cut_vector(ci), da)) * (1.0 / val(c.length))));
-      } else {
-        for (int comp : c.components) rows.push_back(all_->assign("HB" + std::to_string(++row), da[comp]));
-      }
+      if (cut_frame(c) < 0 || c.type == Cut::Type::Hinge) return {};
+      relative_cut_rows(ci, /*with_qdd=*/false, "HB", row, rows);
     }
     return rows;
+  }
+
+  // The second derivatives of the rows of cut ci (written in a joint frame c, not a hinge): d in
+  // c's components depends on the joints between c and the two points only, so its derivatives
+  // are the points' motion relative to c held fixed. `with_qdd` false: at qdd = 0 (Jdot qd).
+  // Rows are assigned as PREFIX1, PREFIX2, ... counting on from `row`.
+  void relative_cut_rows(std::size_t ci, bool with_qdd, const std::string& prefix, int& row, std::vector<Expr>& rows) {
+    const Cut& c = m_.cuts[ci];
+    const int frame = cut_frame(c);
+    const PointMotion b = relative_point_motion(c.b, frame, with_qdd), a = relative_point_motion(c.a, frame, with_qdd);
+    const V3 da = b.acceleration - a.acceleration;
+    if (c.type == Cut::Type::Distance) {
+      const V3 dv = assign("DCV" + std::string(with_qdd ? "" : "B") + std::to_string(ci + 1) + "_", 0, b.velocity - a.velocity);
+      const Expr inverse_length = 1.0 / val(c.length);
+      rows.push_back(all_->assign(prefix + std::to_string(++row), (dot(dv, dv) + dot(cut_vector(ci), da)) * inverse_length));
+    } else {
+      for (int comp : c.components) rows.push_back(all_->assign(prefix + std::to_string(++row), da[comp]));
+    }
   }
 
   // The second time derivative of every cut equation, J qdd + Jdot qd, from the full pass's
@@ -943,17 +953,7 @@ class Generator {
       const int frame = cut_frame(c);
       const std::string tag = std::to_string(ci + 1) + "_";
       if (frame >= 0 && c.type != Cut::Type::Hinge) {
-        // d in the components of frame c depends on the joints between c and the two points
-        // only: its derivatives are the points' motion relative to c, held fixed.
-        const PointMotion b = relative_point_motion(c.b, frame), a = relative_point_motion(c.a, frame);
-        const V3 da = b.acceleration - a.acceleration;
-        if (c.type == Cut::Type::Distance) {
-          const V3 dv = assign("DCV" + tag, 0, b.velocity - a.velocity);
-          const Expr inverse_length = 1.0 / val(c.length);
-          rows.push_back(all_->assign("HA" + std::to_string(++row), (dot(dv, dv) + dot(cut_vector(ci), da)) * inverse_length));
-        } else {
-          for (int comp : c.components) rows.push_back(all_->assign("HA" + std::to_string(++row), da[comp]));
-        }
+        relative_cut_rows(ci, /*with_qdd=*/true, "HA", row, rows);
         continue;
       }
       const PointMotion b = point_motion(c.b, frame), a = point_motion(c.a, frame);
