@@ -248,6 +248,58 @@ class Printer {
   const Context& ctx_;
 };
 
+// The pair type of emit_tangent's two directions per pass, written once into a source file
+// that holds a tangent: a GCC/Clang vector of two doubles (plain members elsewhere), which a
+// double converts to in both lanes, so that a derivative reads primal values and constants as
+// they are printed.
+const char* const kLanes = R"(namespace {
+
+struct Lanes {
+#if defined(__GNUC__)
+  typedef double Pair __attribute__((vector_size(16)));
+  Pair v;
+  Lanes(Pair x) : v(x) {}
+  Lanes(double a, double b) : v(Pair{a, b}) {}
+  double first() const { return v[0]; }
+  double second() const { return v[1]; }
+#else
+  double a_, b_;
+  Lanes(double a, double b) : a_(a), b_(b) {}
+  double first() const { return a_; }
+  double second() const { return b_; }
+#endif
+  Lanes(double x) : Lanes(x, x) {}  // NOLINT(google-explicit-constructor): constants and primal values
+};
+#if defined(__GNUC__)
+inline Lanes operator+(Lanes x, Lanes y) { return Lanes(x.v + y.v); }
+inline Lanes operator-(Lanes x, Lanes y) { return Lanes(x.v - y.v); }
+inline Lanes operator*(Lanes x, Lanes y) { return Lanes(x.v * y.v); }
+inline Lanes operator/(Lanes x, Lanes y) { return Lanes(x.v / y.v); }
+inline Lanes operator-(Lanes x) { return Lanes(-x.v); }
+#else
+inline Lanes operator+(Lanes x, Lanes y) { return Lanes(x.a_ + y.a_, x.b_ + y.b_); }
+inline Lanes operator-(Lanes x, Lanes y) { return Lanes(x.a_ - y.a_, x.b_ - y.b_); }
+inline Lanes operator*(Lanes x, Lanes y) { return Lanes(x.a_ * y.a_, x.b_ * y.b_); }
+inline Lanes operator/(Lanes x, Lanes y) { return Lanes(x.a_ / y.a_, x.b_ / y.b_); }
+inline Lanes operator-(Lanes x) { return Lanes(-x.a_, -x.b_); }
+#endif
+
+// The seeds of two directions: element i of each.
+struct LaneSeed {
+  const double* a;
+  const double* b;
+  Lanes operator[](int i) const { return Lanes(a[i], b[i]); }
+};
+
+inline void store_lanes(double* a, double* b, int j, Lanes x) {
+  a[j] = x.first();
+  b[j] = x.second();
+}
+
+}  // namespace
+
+)";
+
 std::string one_line(std::string s) {
   for (char& c : s) {
     if (c == '\n' || c == '\r') c = ' ';
@@ -366,11 +418,12 @@ void write_prologue(const EquationList& list, const Printer& printer, const Emit
 }
 
 void write_assignments(const EquationList& list, const Printer& printer, std::size_t begin,
-                       std::size_t end, const std::string& indent, std::string& body) {
+                       std::size_t end, const std::string& indent, std::string& body,
+                       const std::string& type = "double") {
   const Context& ctx = list.context();
   for (std::size_t i = begin; i < end; ++i) {
     const Assignment& a = list.assignments()[i];
-    body += indent + "const double " + ctx.symbol(a.target).name + " = ";
+    body += indent + "const " + type + " " + ctx.symbol(a.target).name + " = ";
     printer.print(a.value, body);
     body += ";\n";
   }
@@ -428,21 +481,33 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
     printer.print(o.value, body);
     body += ";  // " + one_line(o.name) + "\n";
   }
-  body += "  for (int d = 0; d < nd; ++d) {\n";
+  // Two directions per pass: the derivative part's arithmetic runs on pairs (Lanes, one SSE2
+  // register), so a direction costs about half the instructions; an odd last direction is paired
+  // with zero seeds and its partner's outputs go to `spare`.
+  std::size_t longest_seed = 1;
+  for (ArrayId a : seeded_arrays) longest_seed = std::max(longest_seed, ctx.array(ctx.seed_array(a)).elements.size());
+  const std::string k = std::to_string(derivative_outputs);
+  body += "  static const double zero_seed[" + std::to_string(longest_seed) + "] = {};\n";
+  body += "  [[maybe_unused]] double spare[" + std::to_string(std::max<std::size_t>(1, derivative_outputs)) + "];\n";
+  body += "  for (int d = 0; d < nd; d += 2) {\n";
+  body += "    const bool pair = d + 1 < nd;\n";
   for (ArrayId a : seeded_arrays) {
     const Array& seed = ctx.array(ctx.seed_array(a));
-    body += "    [[maybe_unused]] const double* " + seed.name + " = seed_" + ctx.array(a).name +
-            " + d*" + std::to_string(seed.elements.size()) + ";\n";
+    const std::string size = std::to_string(seed.elements.size()), from = "seed_" + ctx.array(a).name;
+    body += "    [[maybe_unused]] const LaneSeed " + seed.name + "{" + from + " + d*" + size + ", pair ? " + from +
+            " + (d + 1)*" + size + " : zero_seed};\n";
   }
-  write_assignments(tangent, printer, tangent.primal_assignments(), tangent.size(), "    ", body);
+  body += "    double* const dout_a = dout + d*" + k + ";\n";
+  body += "    [[maybe_unused]] double* const dout_b = pair ? dout_a + " + k + " : spare;\n";
+  write_assignments(tangent, printer, tangent.primal_assignments(), tangent.size(), "    ", body, "auto");
   for (std::size_t j = 0; j < derivative_outputs; ++j) {
     const Output& o = tangent.outputs()[primal_outputs + j];
-    body += "    dout[d*" + std::to_string(derivative_outputs) + " + " + std::to_string(j) + "] = ";
+    body += "    store_lanes(dout_a, dout_b, " + std::to_string(j) + ", ";
     printer.print(o.value, body);
-    body += ";  // " + one_line(o.name) + "\n";
+    body += ");  // " + one_line(o.name) + "\n";
   }
   body += "  }\n}\n";
-  return EmittedFunction{options.function_name, wrapped_signature(signature) + ";\n", body};
+  return EmittedFunction{options.function_name, wrapped_signature(signature) + ";\n", body, true};
 }
 
 EmittedFunction emit_trig_table(std::size_t size, const EmitOptions& options) {
@@ -480,6 +545,8 @@ std::string emit_source_file(std::span<const EmittedFunction> functions, const s
                   "\n";
   if (!header_name.empty()) s += "#include \"" + header_name + "\"\n\n";
   s += "#include <cmath>\n#include <cstring>\n#include <limits>\n\n";
+  if (std::any_of(functions.begin(), functions.end(), [](const EmittedFunction& f) { return f.uses_lanes; }))
+    s += kLanes;
   if (!options.namespace_name.empty()) s += "namespace " + options.namespace_name + " {\n\n";
   for (const EmittedFunction& f : functions) s += f.definition + "\n";
   if (!options.namespace_name.empty()) s += "}  // namespace " + options.namespace_name + "\n";

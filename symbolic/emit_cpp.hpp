@@ -9,7 +9,8 @@
 //   void NAME(const double* q, const double* qd, const double* p, int nd,
 //             const double* seed_q, const double* seed_qd, double* out, double* dout) noexcept;
 // Layout, direction-major columns: seed element (i, d) of array q (size n) is seed_q[d*n + i];
-// derivative (j, d) of output j (m outputs) is dout[d*m + j]. Directions are a run-time loop.
+// derivative (j, d) of output j (m outputs) is dout[d*m + j]. Directions are a run-time loop
+// that takes two at a time (a pair type in the source file, see emit_source_file).
 #pragma once
 
 #include <cstdint>
@@ -39,6 +40,7 @@ struct EmittedFunction {
   std::string name;
   std::string declaration;  // `void NAME(...) noexcept;`
   std::string definition;
+  bool uses_lanes = false;  // a tangent: its source file needs the pair type (emit_source_file adds it)
 };
 
 // A plain function evaluating every assignment and writing every output to out.
