@@ -271,17 +271,17 @@ struct Lanes {
   Lanes(double x) : Lanes(x, x) {}  // NOLINT(google-explicit-constructor): constants and primal values
 };
 #if defined(__GNUC__)
-inline Lanes operator+(Lanes x, Lanes y) { return Lanes(x.v + y.v); }
-inline Lanes operator-(Lanes x, Lanes y) { return Lanes(x.v - y.v); }
-inline Lanes operator*(Lanes x, Lanes y) { return Lanes(x.v * y.v); }
-inline Lanes operator/(Lanes x, Lanes y) { return Lanes(x.v / y.v); }
-inline Lanes operator-(Lanes x) { return Lanes(-x.v); }
+[[maybe_unused]] inline Lanes operator+(Lanes x, Lanes y) { return Lanes(x.v + y.v); }
+[[maybe_unused]] inline Lanes operator-(Lanes x, Lanes y) { return Lanes(x.v - y.v); }
+[[maybe_unused]] inline Lanes operator*(Lanes x, Lanes y) { return Lanes(x.v * y.v); }
+[[maybe_unused]] inline Lanes operator/(Lanes x, Lanes y) { return Lanes(x.v / y.v); }
+[[maybe_unused]] inline Lanes operator-(Lanes x) { return Lanes(-x.v); }
 #else
-inline Lanes operator+(Lanes x, Lanes y) { return Lanes(x.a_ + y.a_, x.b_ + y.b_); }
-inline Lanes operator-(Lanes x, Lanes y) { return Lanes(x.a_ - y.a_, x.b_ - y.b_); }
-inline Lanes operator*(Lanes x, Lanes y) { return Lanes(x.a_ * y.a_, x.b_ * y.b_); }
-inline Lanes operator/(Lanes x, Lanes y) { return Lanes(x.a_ / y.a_, x.b_ / y.b_); }
-inline Lanes operator-(Lanes x) { return Lanes(-x.a_, -x.b_); }
+[[maybe_unused]] inline Lanes operator+(Lanes x, Lanes y) { return Lanes(x.a_ + y.a_, x.b_ + y.b_); }
+[[maybe_unused]] inline Lanes operator-(Lanes x, Lanes y) { return Lanes(x.a_ - y.a_, x.b_ - y.b_); }
+[[maybe_unused]] inline Lanes operator*(Lanes x, Lanes y) { return Lanes(x.a_ * y.a_, x.b_ * y.b_); }
+[[maybe_unused]] inline Lanes operator/(Lanes x, Lanes y) { return Lanes(x.a_ / y.a_, x.b_ / y.b_); }
+[[maybe_unused]] inline Lanes operator-(Lanes x) { return Lanes(-x.a_, -x.b_); }
 #endif
 
 // The seeds of two directions: element i of each.
@@ -291,7 +291,7 @@ struct LaneSeed {
   Lanes operator[](int i) const { return Lanes(a[i], b[i]); }
 };
 
-inline void store_lanes(double* a, double* b, int j, Lanes x) {
+[[maybe_unused]] inline void store_lanes(double* a, double* b, int j, Lanes x) {
   a[j] = x.first();
   b[j] = x.second();
 }

@@ -115,18 +115,27 @@ bool BlockLU::compute(const Matrix& A) {
   return regular;
 }
 
-bool BlockLU::compute(const Matrix& A, const std::vector<int>& cols) {
-  if (A.rows() != size_ || static_cast<int>(cols.size()) != size_)
-    throw std::invalid_argument("BlockLU: size differs from the pattern");
+template <typename Entry>
+bool BlockLU::compute_from(Entry entry, const std::vector<int>& cols) {
+  if (static_cast<int>(cols.size()) != size_) throw std::invalid_argument("BlockLU: size differs from the pattern");
   bool regular = true;
   inverted_ = false;
   for (Block& b : blocks_) {
     const int k = static_cast<int>(b.rows.size());
     for (int c = 0; c < k; ++c)
-      for (int i = 0; i < k; ++i) b.lu[c * k + i] = A(b.rows[i], cols[b.cols[c]]);
+      for (int i = 0; i < k; ++i) b.lu[c * k + i] = entry(b.rows[i], cols[b.cols[c]]);
     regular = factor(b) && regular;
   }
   return regular;
+}
+
+bool BlockLU::compute(const Matrix& A, const std::vector<int>& cols) {
+  if (A.rows() != size_) throw std::invalid_argument("BlockLU: size differs from the pattern");
+  return compute_from([&A](int i, int j) { return A(i, j); }, cols);
+}
+
+bool BlockLU::compute_rows(const double* a, Eigen::Index ld, const std::vector<int>& cols) {
+  return compute_from([a, ld](int i, int j) { return a[i * ld + j]; }, cols);
 }
 
 void BlockLU::solve(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs, double* x, Eigen::Index ldx) const {

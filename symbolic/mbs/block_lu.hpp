@@ -24,6 +24,8 @@ class BlockLU {
   // singular.
   bool compute(const Matrix& A);
   bool compute(const Matrix& A, const std::vector<int>& cols);
+  // The same from a row-major array: A(i, j) at a[i * ld + j] (a generated Jacobian as written).
+  bool compute_rows(const double* a, Eigen::Index ld, const std::vector<int>& cols);
   // x with A x = b, and y with A^T y = b, for b of the pattern's rows and `nrhs` columns
   // (column-major, leading dimensions ldb and ldx); x may be b.
   // The blocks' inverses from the factors. Before invert(), solve substitutes through the
@@ -48,6 +50,8 @@ class BlockLU {
     std::vector<double> inverse;  // k x k, row-major: block column c of x = sum over block rows
   };
   bool factor(Block& b);
+  template <typename Entry>
+  bool compute_from(Entry entry, const std::vector<int>& cols);
   // z := A_block^-1 z through the factors (the block's exchanges, then L and U)
   static void apply_factors(const Block& b, double* z);
   void substitute(const double* b, Eigen::Index ldb, Eigen::Index nrhs, double* x, Eigen::Index ldx) const;

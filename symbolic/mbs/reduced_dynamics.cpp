@@ -70,7 +70,7 @@ void ReducedDynamics::solve_kinematics(const double* u, const double* ud, const 
   const int n = model_.n, m = model_.m, nu = this->nu();
   const double* p = params(p_in);
   Result::Work& w = r.work;
-  w.lam_zero.assign(std::max(1, m), 0.0);
+  if (static_cast<int>(w.lam_zero.size()) != std::max(1, m)) w.lam_zero.assign(std::max(1, m), 0.0);  // never written
   r.q = guess;
   r.qd.setZero(n);
   r.qdd.setZero(n);
@@ -85,23 +85,18 @@ void ReducedDynamics::solve_kinematics(const double* u, const double* ud, const 
   }
   const double* in = model_.inputs ? inputs : pad_.data();
 
-  // Constraints: h, J.
+  // Constraints: h, then J row-major (read in place by the iteration, copied to r.J at the end).
   w.hj.resize(m + m * n + 1);
   r.J.resize(m, n);
-  auto evaluate_constraints = [&] {
-    model_.constraints(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, w.hj.data());
-    for (int i = 0; i < m; ++i)
-      for (int j = 0; j < n; ++j) r.J(i, j) = w.hj[m + i * n + j];
-  };
   r.newton_iterations = 0;
   if (m > 0) {
     if (r.Jv.size() != m) r.Jv = jv_blocks_;
     w.fv.resize(m);
     for (;;) {
-      evaluate_constraints();
+      model_.constraints(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, w.hj.data());
       double norm = 0.0;
       for (int i = 0; i < m; ++i) norm = std::max(norm, std::abs(w.hj[i]));
-      if (!r.Jv.compute(r.J, v_) && std::isfinite(norm))
+      if (!r.Jv.compute_rows(w.hj.data() + m, n, v_) && std::isfinite(norm))
         throw std::runtime_error(std::string(model_.name) + ": the constraint Jacobian is singular");
       if (norm < 1e-13) break;
       if (++r.newton_iterations > 30 || !std::isfinite(norm))
@@ -110,6 +105,7 @@ void ReducedDynamics::solve_kinematics(const double* u, const double* ud, const 
       for (int i = 0; i < m; ++i) r.q[v_[i]] -= w.fv[i];
     }
     r.Jv.invert();  // the factors at the solution serve many right-hand sides from here on
+    r.J = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(w.hj.data() + m, m, n);
     w.fv.noalias() = r.J * r.qd;  // Jv vd = -J qd (vd still zero in qd)
     r.Jv.solve(w.fv.data(), m, 1, w.fv.data(), m);
     for (int i = 0; i < m; ++i) r.qd[v_[i]] = -w.fv[i];
@@ -121,7 +117,7 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   const double* p = params(p_in);
   const double* lam0 = pad_.data();
   Result::Work& w = r.work;
-  w.lam_zero.assign(std::max(1, m), 0.0);
+  if (static_cast<int>(w.lam_zero.size()) != std::max(1, m)) w.lam_zero.assign(std::max(1, m), 0.0);
   const double* in = model_.inputs ? inputs : pad_.data();
   r.qdd.setZero(n);
   for (std::size_t i = 0; i < d_.size(); ++i) r.qdd[d_[i]] = inputs[model_.load_inputs + 3 * i + 2];
@@ -133,8 +129,8 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
 
   const int nf = static_cast<int>(f_.size());
   // B over the free coordinates: rows u (identity) and v (-Jv^-1 Ju).
-  r.B.setZero(nf, nu);
-  w.beta.setZero(nf);
+  r.B.resize(nf, nu);  // every entry written below
+  w.beta.resize(nf);
   if (m > 0) {
     w.Ju.resize(m, nu);
     for (int i = 0; i < nu; ++i) w.Ju.col(i) = r.J.col(u_[i]);
@@ -146,7 +142,9 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   for (int a = 0; a < nf; ++a) {
     const int place = free_place_[a];
     if (place >= 0) {
+      r.B.row(a).setZero();
       r.B(a, place) = 1.0;
+      w.beta[a] = 0.0;
     } else {
       r.B.row(a) = -w.Bv.row(-1 - place);
       w.beta[a] = -w.beta_v(-1 - place, 0);
@@ -194,25 +192,26 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   }
 
   const bool whole = identity && nf == n;  // no driven joints either: M_ff B is M
-  w.Mbeta.setZero(nf);
+  w.Mbeta.resize(nf);
   w.cf.resize(nf);
   if (!whole) r.MBf.resize(nf, nu);  // M_ff B
   for (int a = 0; a < nf; ++a) {
     if (!whole) r.MBf.row(a) = r.MB.row(f_[a]).head(nu);
-    if (m > 0) w.Mbeta[a] = r.MB(f_[a], nu);
+    w.Mbeta[a] = m > 0 ? r.MB(f_[a], nu) : 0.0;
     w.cf[a] = c[f_[a]];
   }
+  bool definite = false;
   if (whole) {
-    r.reduced.compute(r.MB);
+    definite = r.reduced.compute(r.MB);
   } else if (identity) {
-    r.reduced.compute(r.MBf);
+    definite = r.reduced.compute(r.MBf);
   } else {
     w.reduced.setZero(nu, nu);  // B^T M_ff B over B's structure
     for (int a = 0; a < nf; ++a)
       for (int c : b_cols_[a]) w.reduced.row(c) += r.B(a, c) * r.MBf.row(a);
-    r.reduced.compute(w.reduced);
+    definite = r.reduced.compute(w.reduced);
   }
-  if (r.reduced.info() != Eigen::Success)
+  if (!definite)
     throw std::runtime_error(std::string(model_.name) + ": reduced mass matrix is not positive definite");
   w.cf += w.Mbeta;
   if (identity) {
@@ -222,7 +221,7 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
     for (int a = 0; a < nf; ++a)
       for (int c : b_cols_[a]) r.udd[c] += r.B(a, c) * w.cf[a];
   }
-  r.reduced.solveInPlace(r.udd);
+  r.reduced.solve_in_place(r.udd);
   r.udd = -r.udd;
   w.qddf = w.beta;
   for (int a = 0; a < nf; ++a)
@@ -230,12 +229,10 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   for (int a = 0; a < nf; ++a) r.qdd[f_[a]] = w.qddf[a];
 
   // Multipliers: J^T lam = M qdd + c on the dependent rows, M qdd = M B udd + M beta.
-  r.lam.setZero(m);
-  if (m > 0) {
-    w.full = c + r.MB.col(nu);
-    w.full.noalias() += r.MB.leftCols(nu) * r.udd;
+  r.lam.resize(m);
+  if (m > 0) {  // (the dependent rows only)
     w.fv.resize(m);
-    for (int i = 0; i < m; ++i) w.fv[i] = w.full[v_[i]];
+    for (int i = 0; i < m; ++i) w.fv[i] = c[v_[i]] + r.MB(v_[i], nu) + r.MB.row(v_[i]).head(nu).dot(r.udd);
     r.Jv.transpose_solve(w.fv.data(), m, 1, r.lam.data(), m);
   }
 }
@@ -326,7 +323,7 @@ void ReducedDynamics::tangent_dynamics(const Result& r, const double* inputs, co
   // (M_ff B)^T dbeta, M being symmetric, with M_ff B from solve_dynamics
   if (m == 0 && u_ == f_) {
     w.dudd = w.drf;
-    r.reduced.solveInPlace(w.dudd);
+    r.reduced.solve_in_place(w.dudd);
     for (int a = 0; a < nf; ++a) dqdd.row(f_[a]) = -w.dudd.row(a);
     return;
   }
@@ -334,7 +331,7 @@ void ReducedDynamics::tangent_dynamics(const Result& r, const double* inputs, co
   w.dudd.noalias() = r.MBf.transpose() * w.dbeta;
   for (int a = 0; a < nf; ++a)  // + B^T drf over B's structure
     for (int c : b_cols_[a]) w.dudd.row(c) += r.B(a, c) * w.drf.row(a);
-  r.reduced.solveInPlace(w.dudd);
+  r.reduced.solve_in_place(w.dudd);
   w.dudd = -w.dudd;
   w.drf = w.dbeta;  // dqdd on the free coordinates: dbeta + B dudd
   for (int a = 0; a < nf; ++a)

@@ -12,6 +12,7 @@
 
 #include "symbolic/mbs/block_lu.hpp"
 #include "symbolic/mbs/generated_model.hpp"
+#include "symbolic/mbs/reduced_cholesky.hpp"
 
 namespace dydp::mbs {
 
@@ -32,14 +33,14 @@ class ReducedDynamics {
     Matrix J;                                     // m x n
     BlockLU Jv;                                   // dependent columns of J, loop by loop
     Matrix B;                                     // free coordinates x nu
-    Eigen::LLT<Matrix> reduced;                   // B^T M_ff B
+    ReducedCholesky reduced;                      // B^T M_ff B
     Matrix seeds, MBf;                            // [B beta] over q, M_ff B
     int newton_iterations = 0;
     // Scratch storage sized at the first call and reused, so that a solve and its tangents
     // allocate nothing once the sizes are known (the right-hand side's path).
     struct Work {
       std::vector<double> hj, res, out, lam_zero, mass, s_val;
-      Vector beta, cf, Mbeta, full, fv, qddf;
+      Vector beta, cf, Mbeta, fv, qddf;
       Matrix Ju, Bv, beta_v, reduced;
       Matrix dinp, dp, dqdd_seed, dout, dh, dv, dbeta_v, dbeta, drf, dudd;
     };

@@ -146,7 +146,7 @@ Equilibrium static_equilibrium(const Sedan& s) {
   auto reduced_force = [&](const Vector& in) {
     ReducedDynamics::Result r;
     s.reduced.solve(u.data(), ud.data(), in.data(), nullptr, s.q0, r);
-    return Vector(r.reduced.matrixL() * (r.reduced.matrixL().transpose() * r.udd));  // B^T M B udd
+    return Vector(r.B.transpose() * (r.MBf * r.udd));  // B^T M B udd
   };
   const Vector zero = Vector::Zero(s.g.inputs);
   const Vector f0 = reduced_force(zero);
