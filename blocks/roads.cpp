@@ -2,6 +2,7 @@
 // test rig (sines plus smooth noise), an ISO 8608 random road, and a profile of discrete
 // obstacles. Outputs `z` [m] and `zdot` [m/s], width 4 each, closed-form in time.
 #include <cmath>
+#include <complex>
 #include <limits>
 #include <numbers>
 #include <random>
@@ -52,7 +53,10 @@ class FourPoster : public Block {
   enum { kNoiseRms = 12, kNoiseLow, kNoiseHigh };
   FourPoster(unsigned long long seed, int components, std::vector<TimeSeries> recorded)
       : components_(components), recorded_(std::move(recorded)) {
-    for (int pad = 0; pad < 4; ++pad) phases_[pad] = random_phases(seed + 7919ull * pad, components);
+    for (int pad = 0; pad < 4; ++pad) {
+      const std::vector<double> phases = random_phases(seed + 7919ull * pad, components);
+      for (double phase : phases) phase_turn_[pad].emplace_back(std::cos(phase), std::sin(phase));
+    }
     declare_output("z", 4, "m");
     declare_output("zdot", 4, "m/s");
   }
@@ -63,6 +67,28 @@ class FourPoster : public Block {
   double noise_frequency(const double* p, int k) const {
     return p[kNoiseLow] + (k + 0.5) * (p[kNoiseHigh] - p[kNoiseLow]) / components_;
   }
+  // Per pad, sum_k sin(w_k t + theta_k) and sum_k w_k cos(w_k t + theta_k). The frequencies are
+  // evenly spaced and the same for every pad, so exp(i w_k t) = exp(i w_0 t) exp(i dw t)^k
+  // comes by one complex product per component (two sincos per call, not one per component and
+  // pad), then turned by each pad's exp(i theta_k).
+  void noise_sums(const double* p, double t, double sin_sum[4], double cos_sum[4]) const {
+    const double w0 = kTwoPi * noise_frequency(p, 0), dw = kTwoPi * (p[kNoiseHigh] - p[kNoiseLow]) / components_;
+    // (complex products written out: std::complex's operator* checks for infinities per call)
+    const double step_c = std::cos(dw * t), step_s = std::sin(dw * t);
+    double turn_c = std::cos(w0 * t), turn_s = std::sin(w0 * t);
+    for (int pad = 0; pad < 4; ++pad) sin_sum[pad] = cos_sum[pad] = 0.0;
+    for (int k = 0; k < components_; ++k) {
+      const double wk = w0 + k * dw;
+      for (int pad = 0; pad < 4; ++pad) {
+        const std::complex<double> phase = phase_turn_[pad][k];
+        sin_sum[pad] += turn_s * phase.real() + turn_c * phase.imag();
+        cos_sum[pad] += wk * (turn_c * phase.real() - turn_s * phase.imag());
+      }
+      const double c = turn_c * step_c - turn_s * step_s;
+      turn_s = turn_s * step_c + turn_c * step_s;
+      turn_c = c;
+    }
+  }
 
   void outputs(const Eval& e, double* const* y) const override {
     if (!recorded_.empty()) {
@@ -71,18 +97,13 @@ class FourPoster : public Block {
     }
     const double* p = e.p;
     const double a = p[kNoiseRms] * std::sqrt(2.0 / components_);
+    double sin_sum[4], cos_sum[4];
+    noise_sums(p, e.t, sin_sum, cos_sum);
     for (int pad = 0; pad < 4; ++pad) {
       const double w = kTwoPi * p[frequency(pad)];
       const double arg = w * e.t + p[phase(pad)];
-      double z = p[amplitude(pad)] * std::sin(arg), zdot = p[amplitude(pad)] * w * std::cos(arg);
-      for (int k = 0; k < components_; ++k) {
-        const double wk = kTwoPi * noise_frequency(p, k);
-        const double argk = wk * e.t + phases_[pad][k];
-        z += a * std::sin(argk);
-        zdot += a * wk * std::cos(argk);
-      }
-      y[0][pad] = z;
-      y[1][pad] = zdot;
+      y[0][pad] = p[amplitude(pad)] * std::sin(arg) + a * sin_sum[pad];
+      y[1][pad] = p[amplitude(pad)] * w * std::cos(arg) + a * cos_sum[pad];
     }
   }
   void outputs_tangent(const Eval& e, const Seeds& s, const DirView* dy) const override {
@@ -93,17 +114,13 @@ class FourPoster : public Block {
     }
     const double* p = e.p;
     const double noise_shape = std::sqrt(2.0 / components_);
+    double sin_sum[4], cos_sum[4];
+    noise_sums(p, e.t, sin_sum, cos_sum);
     for (int pad = 0; pad < 4; ++pad) {
       const double amp = p[amplitude(pad)], w = kTwoPi * p[frequency(pad)];
       const double arg = w * e.t + p[phase(pad)], sn = std::sin(arg), cs = std::cos(arg);
       // The noise's contribution is linear in noise_rms: its tangent is (noise / noise_rms) d rms.
-      double unit_z = 0, unit_zdot = 0;
-      for (int k = 0; k < components_; ++k) {
-        const double wk = kTwoPi * noise_frequency(p, k);
-        const double argk = wk * e.t + phases_[pad][k];
-        unit_z += noise_shape * std::sin(argk);
-        unit_zdot += noise_shape * wk * std::cos(argk);
-      }
+      const double unit_z = noise_shape * sin_sum[pad], unit_zdot = noise_shape * cos_sum[pad];
       for (int d = 0; d < s.directions; ++d) {
         const double da = s.p(amplitude(pad), d), dw = kTwoPi * s.p(frequency(pad), d);
         const double darg = dw * e.t + s.p(phase(pad), d), drms = s.p(kNoiseRms, d);
@@ -115,7 +132,7 @@ class FourPoster : public Block {
 
  private:
   int components_;
-  std::vector<double> phases_[4];
+  std::vector<std::complex<double>> phase_turn_[4];  // exp(i theta_k) of each pad's components
   std::vector<TimeSeries> recorded_;
 };
 

@@ -101,6 +101,24 @@ TEST(Roads, FourPosterNoiseHasTheRequestedRmsAndIsSeeded) {
   EXPECT_NE(road_at(*b, p, 1.234).z[0], road_at(*b, p, 1.234).z[1]) << "pads have their own phases";
 }
 
+// The noise's sines come from one rotation per component (exp(i w_k t) by products, not a
+// sincos each): the rate must still be the height's derivative, early and late in a long run,
+// with the sine and noise together (central differences, h = 1e-5 s: error ~ h^2 zddd / 6).
+TEST(Roads, FourPosterRateIsTheDerivativeOfTheHeightAtAnyTime) {
+  BlockCase c = road_case("road.fourposter");
+  c.params = {{"noise_rms", 0.002}, {"noise_high", 25.0}};
+  std::vector<double> p;
+  auto b = make_block(c, &p);
+  const double h = 1e-5;
+  for (double t : {0.3, 17.9, 600.2, 3600.7}) {
+    const Sample s = road_at(*b, p, t), plus = road_at(*b, p, t + h), minus = road_at(*b, p, t - h);
+    for (int i = 0; i < 4; ++i) {
+      const double rate = (plus.z[i] - minus.z[i]) / (2 * h);
+      EXPECT_NEAR(s.zdot[i], rate, 1e-6 * std::max(0.01, std::abs(s.zdot[i]))) << "t " << t << " pad " << i;
+    }
+  }
+}
+
 TEST(Roads, Iso8608VarianceFollowsTheClassPsd) {
   // Variance of the synthesis = sum Gd(n_k) dn; for n_k on the midpoint grid this approximates
   // the integral of Gd(n0) (n / n0)^-2 over the band, Gd(n0) n0^2 (1 / n_min - 1 / n_max).
