@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <algorithm>
 #include <stdexcept>
+#include <unordered_map>
 
 #include "symbolic/op_count.hpp"
 
@@ -60,8 +61,19 @@ bool small_integer_power(const Context& ctx, NodeId n, int* exponent) {
 class Printer {
  public:
   explicit Printer(const Context& ctx) : ctx_(ctx) {}
+  // Nodes printed under another name where they are arithmetic operands (a tangent's primal
+  // values broadcast to both lanes before its loop); conditions and function arguments keep
+  // the plain names.
+  Printer(const Context& ctx, const std::unordered_map<NodeId, std::string>* renamed) : ctx_(ctx), renamed_(renamed) {}
 
   void print(NodeId n, std::string& out) const {
+    if (renamed_ && renaming_) {
+      const auto it = renamed_->find(n);
+      if (it != renamed_->end()) {
+        out += it->second;
+        return;
+      }
+    }
     switch (ctx_.op(n)) {
       case Op::Constant: {
         const double v = ctx_.value(n);
@@ -131,6 +143,7 @@ class Printer {
       case Op::Max: call("std::fmax", n, out); return;
       case Op::Sign: {
         std::string x;
+        const Plain plain(*this);
         wrapped(ctx_.children(n)[0], 3, x);
         out += "(" + x + " > 0.0 ? 1.0 : (" + x + " < 0.0 ? -1.0 : 0.0))";
         return;
@@ -138,7 +151,10 @@ class Printer {
       case Op::Select: {
         auto k = ctx_.children(n);
         out += "(";
-        wrapped(k[0], 1, out);
+        {
+          const Plain plain(*this);
+          wrapped(k[0], 1, out);
+        }
         out += " > 0.0 ? ";
         print(k[1], out);
         out += " : ";
@@ -180,6 +196,7 @@ class Printer {
   }
 
   void call(const char* function, NodeId n, std::string& out) const {
+    const Plain plain(*this);
     out += function;
     out += "(";
     bool first = true;
@@ -245,7 +262,17 @@ class Printer {
     else if (denominator_factors > 1) out += "/(" + denominator + ")";
   }
 
+  // Renaming off for its lifetime (restored after).
+  struct Plain {
+    explicit Plain(const Printer& p) : printer(p), was(p.renaming_) { p.renaming_ = false; }
+    ~Plain() { printer.renaming_ = was; }
+    const Printer& printer;
+    bool was;
+  };
+
   const Context& ctx_;
+  const std::unordered_map<NodeId, std::string>* renamed_ = nullptr;
+  mutable bool renaming_ = true;
 };
 
 // The pair type of emit_tangent's two directions per pass, written once into a source file
@@ -484,6 +511,51 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
   // Two directions per pass: the derivative part's arithmetic runs on pairs (Lanes, one SSE2
   // register), so a direction costs about half the instructions; an odd last direction is paired
   // with zero seeds and its partner's outputs go to `spare`.
+  // The primal values the derivative part reads, broadcast to both lanes once before the loop:
+  // read in the loop as a pair from memory, not loaded and unpacked once per pass.
+  std::unordered_map<NodeId, std::string> lane_names;
+  {
+    std::vector<char> primal(ctx.size(), 0), seen(ctx.size(), 0);
+    for (std::size_t i = 0; i < tangent.primal_assignments(); ++i) primal[tangent.assignments()[i].target] = 1;
+    std::vector<NodeId> stack;
+    auto walk = [&](NodeId root) {
+      stack.push_back(root);
+      while (!stack.empty()) {
+        const NodeId x = stack.back();
+        stack.pop_back();
+        if (seen[x]) continue;
+        seen[x] = 1;
+        const Op op = ctx.op(x);
+        if (op == Op::Select || op == Op::Sign || (op != Op::Add && op != Op::Mul && op != Op::Neg && op != Op::Div &&
+                                                  op != Op::Symbol && op != Op::Constant && !ctx.is_abbreviation(x)))
+          continue;  // conditions and function arguments keep plain names
+        std::string name;
+        if (ctx.is_abbreviation(x)) {
+          name = ctx.abbreviation_name(x);
+        } else if (op == Op::Symbol) {
+          const Symbol& sym = ctx.symbol(x);
+          if (sym.kind == SymbolKind::Aux && primal[x]) name = sym.name;
+          else if (sym.kind == SymbolKind::Input || sym.kind == SymbolKind::Parameter)
+            name = ctx.array(sym.array).name + "_" + std::to_string(sym.index);
+        }
+        if (!name.empty()) {
+          lane_names.emplace(x, "lane_" + name);
+          continue;
+        }
+        for (NodeId c : ctx.children(x)) stack.push_back(c);
+      }
+    };
+    for (std::size_t i = tangent.primal_assignments(); i < tangent.size(); ++i) walk(tangent.assignments()[i].value);
+    for (std::size_t j = primal_outputs; j < tangent.outputs().size(); ++j) walk(tangent.outputs()[j].value);
+    std::vector<std::pair<NodeId, std::string>> sorted(lane_names.begin(), lane_names.end());
+    std::sort(sorted.begin(), sorted.end());
+    for (const auto& [x, name] : sorted) {
+      body += "  const Lanes " + name + " = ";
+      printer.print(x, body);
+      body += ";\n";
+    }
+  }
+  const Printer lane_printer(ctx, &lane_names);
   std::size_t longest_seed = 1;
   for (ArrayId a : seeded_arrays) longest_seed = std::max(longest_seed, ctx.array(ctx.seed_array(a)).elements.size());
   const std::string k = std::to_string(derivative_outputs);
@@ -499,11 +571,11 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
   }
   body += "    double* const dout_a = dout + d*" + k + ";\n";
   body += "    [[maybe_unused]] double* const dout_b = pair ? dout_a + " + k + " : spare;\n";
-  write_assignments(tangent, printer, tangent.primal_assignments(), tangent.size(), "    ", body, "auto");
+  write_assignments(tangent, lane_printer, tangent.primal_assignments(), tangent.size(), "    ", body, "auto");
   for (std::size_t j = 0; j < derivative_outputs; ++j) {
     const Output& o = tangent.outputs()[primal_outputs + j];
     body += "    store_lanes(dout_a, dout_b, " + std::to_string(j) + ", ";
-    printer.print(o.value, body);
+    lane_printer.print(o.value, body);
     body += ");  // " + one_line(o.name) + "\n";
   }
   body += "  }\n}\n";

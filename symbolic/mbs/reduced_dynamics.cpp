@@ -48,6 +48,12 @@ ReducedDynamics::ReducedDynamics(const GeneratedModel& model) : model_(model), p
     free_row_of_[f_[a]] = static_cast<int>(a);
     b_cols_[a] = free_place_[a] >= 0 ? std::vector<int>{free_place_[a]} : block_u[block_of_v[-1 - free_place_[a]]];
   }
+  for (std::size_t a = 0; a < f_.size(); ++a) {
+    if (free_place_[a] < 0) dependent_rows_.emplace_back(static_cast<int>(a), -1 - free_place_[a]);
+    if (free_place_[a] >= 0) independent_rows_.push_back({f_[a], free_place_[a]});
+    else
+      for (int c : b_cols_[a]) dependent_entries_.push_back({f_[a], c, c * static_cast<int>(f_.size()) + static_cast<int>(a)});
+  }
   s_start_.assign(1, 0);
   for (int j = 0; j < n; ++j) {
     const int a = free_row_of_[j];
@@ -292,51 +298,71 @@ void ReducedDynamics::tangent(const Result& r, const double* inputs, const doubl
                               const double* dud, const double* dinputs, const double* dp, Matrix& dq, Matrix& dqd,
                               Matrix& dqdd) const {
   tangent_kinematics(r, inputs, p, nd, du, dud, dinputs, dp, dq, dqd);
-  tangent_dynamics(r, inputs, p, nd, dinputs, dp, dq, dqd, dqdd);
+  dqdd = r.work.dqdd_seed;  // the seeds tangent_kinematics arranged serve the dynamic half too
+  dynamics_from_seeds(r, inputs, p, nd, dq, dqd, dqdd);
 }
 
 void ReducedDynamics::tangent_dynamics(const Result& r, const double* inputs, const double* p_in, int nd,
                                        const double* dinputs, const double* dp_in, const Matrix& dq,
                                        const Matrix& dqd, Matrix& dqdd) const {
+  seed_arrays(nd, dinputs, dp_in, r.work.dinp, r.work.dp, dqdd);
+  dynamics_from_seeds(r, inputs, p_in, nd, dq, dqd, dqdd);
+}
+
+void ReducedDynamics::dynamics_from_seeds(const Result& r, const double* inputs, const double* p_in, int nd,
+                                          const Matrix& dq, const Matrix& dqd, Matrix& dqdd) const {
   const int n = model_.n, m = model_.m;
   const double* p = params(p_in);
   const double* in = model_.inputs ? inputs : pad_.data();
   Result::Work& w = r.work;
-  seed_arrays(nd, dinputs, dp_in, w.dinp, w.dp, dqdd);
   const double* lam = m ? r.lam.data() : pad_.data();
   // dr = dM qdd + dc - dJ^T lam (qdd, lam frozen; driven dqdd seeded), da = dJ qdd + d(Jdot qd).
   w.out.resize(n + m);
   w.dout.resize(n + m, nd);
   model_.residual_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam, in, p, nd, dq.data(), dqd.data(),
                           dqdd.data(), w.dinp.data(), w.dp.data(), w.out.data(), w.dout.data());
-  const int nf = static_cast<int>(f_.size());
-  w.dbeta.setZero(nf, nd);
-  w.drf.resize(nf, nd);
-  if (m > 0) {
-    w.dbeta_v.resize(m, nd);
-    r.Jv.solve(w.dout.data() + n, n + m, nd, w.dbeta_v.data(), m);
-    for (int a = 0; a < nf; ++a)
-      if (free_place_[a] < 0) w.dbeta.row(a) = -w.dbeta_v.row(-1 - free_place_[a]);
-  }
-  for (int a = 0; a < nf; ++a) w.drf.row(a) = w.dout.row(f_[a]);
-  // a tree in coordinate order: B = I (see solve_dynamics); otherwise B^T M_ff dbeta =
-  // (M_ff B)^T dbeta, M being symmetric, with M_ff B from solve_dynamics
+  const int nf = static_cast<int>(f_.size()), nu = this->nu(), rows = n + m;
+  w.dudd.resize(nu, nd);
+  double* dudd = w.dudd.data();
+  // a tree in coordinate order: B = I (see solve_dynamics), dudd = -M^-1 dr
   if (m == 0 && u_ == f_) {
-    w.dudd = w.drf;
-    r.reduced.solve_in_place(w.dudd);
-    for (int a = 0; a < nf; ++a) dqdd.row(f_[a]) = -w.dudd.row(a);
+    for (int d = 0; d < nd; ++d)
+      for (int a = 0; a < nf; ++a) dudd[d * nu + a] = w.dout(f_[a], d);
+    r.reduced.solve_in_place(dudd, nu, nd);
+    for (int d = 0; d < nd; ++d)
+      for (int a = 0; a < nf; ++a) dqdd(f_[a], d) = -dudd[d * nu + a];
     return;
   }
-  w.dudd.resize(nu(), nd);
-  w.dudd.noalias() = r.MBf.transpose() * w.dbeta;
-  for (int a = 0; a < nf; ++a)  // + B^T drf over B's structure
-    for (int c : b_cols_[a]) w.dudd.row(c) += r.B(a, c) * w.drf.row(a);
-  r.reduced.solve_in_place(w.dudd);
-  w.dudd = -w.dudd;
-  w.drf = w.dbeta;  // dqdd on the free coordinates: dbeta + B dudd
-  for (int a = 0; a < nf; ++a)
-    for (int c : b_cols_[a]) w.drf.row(a) += r.B(a, c) * w.dudd.row(c);
-  for (int a = 0; a < nf; ++a) dqdd.row(f_[a]) = w.drf.row(a);
+  // dbeta = -Jv^-1 da on the dependent rows (zero on the independent ones); then, direction by
+  // direction over B's structure, B^T M_ff (B dudd + dbeta) = -B^T dr: the right-hand side
+  // B^T dr + (M_ff B)^T dbeta (M symmetric, M_ff B from solve_dynamics), solved, and
+  // dqdd = B dudd + dbeta on the free coordinates.
+  if (m > 0) {
+    w.dbeta_v.resize(m, nd);
+    r.Jv.solve(w.dout.data() + n, rows, nd, w.dbeta_v.data(), m);
+    w.MBv.resize(m, nu);  // the dependent rows of M_ff B: dbeta is zero on the others
+    for (const auto& [a, k] : dependent_rows_) w.MBv.row(k) = r.MBf.row(a);
+    w.dudd.noalias() = w.MBv.transpose() * w.dbeta_v;  // -(M_ff B)^T dbeta
+  } else {
+    w.dudd.setZero();
+  }
+  const double* B = r.B.data();
+  for (int d = 0; d < nd; ++d) {
+    const double* dr = w.dout.data() + static_cast<Eigen::Index>(d) * rows;
+    double* __restrict rhs = dudd + static_cast<Eigen::Index>(d) * nu;
+    for (int c = 0; c < nu; ++c) rhs[c] = -rhs[c];
+    for (const IndependentRow& u : independent_rows_) rhs[u.place] += dr[u.q];
+    for (const DependentEntry& e : dependent_entries_) rhs[e.c] += B[e.b] * dr[e.q];
+  }
+  r.reduced.solve_in_place(dudd, nu, nd);  // -dudd
+  for (int d = 0; d < nd; ++d) {
+    const double* dbv = m > 0 ? w.dbeta_v.data() + static_cast<Eigen::Index>(d) * m : nullptr;
+    const double* minus_du = dudd + static_cast<Eigen::Index>(d) * nu;
+    double* __restrict out = dqdd.data() + static_cast<Eigen::Index>(d) * n;
+    for (const IndependentRow& u : independent_rows_) out[u.q] = -minus_du[u.place];
+    for (const auto& [a, k] : dependent_rows_) out[f_[a]] = -dbv[k];
+    for (const DependentEntry& e : dependent_entries_) out[e.q] -= B[e.b] * minus_du[e.c];
+  }
 }
 
 }  // namespace dydp::mbs

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <utility>
 #include <vector>
 
 #include "symbolic/mbs/block_lu.hpp"
@@ -41,8 +42,8 @@ class ReducedDynamics {
     struct Work {
       std::vector<double> hj, res, out, lam_zero, mass, s_val;
       Vector beta, cf, Mbeta, fv, qddf;
-      Matrix Ju, Bv, beta_v, reduced;
-      Matrix dinp, dp, dqdd_seed, dout, dh, dv, dbeta_v, dbeta, drf, dudd;
+      Matrix Ju, Bv, beta_v, reduced, MBv;
+      Matrix dinp, dp, dqdd_seed, dout, dh, dv, dbeta_v, dudd;
     };
     mutable Work work;
   };
@@ -82,6 +83,10 @@ class ReducedDynamics {
   // driven joints' accelerations.
   void seed_arrays(int nd, const double* dinputs, const double* dp, Matrix& dinp, Matrix& dp_out,
                    Matrix& dqdd) const;
+  // tangent_dynamics() after seed_arrays: r.work.dinp and dp hold the seeds, dqdd the driven
+  // joints' seeded accelerations.
+  void dynamics_from_seeds(const Result& r, const double* inputs, const double* p, int nd, const Matrix& dq,
+                           const Matrix& dqd, Matrix& dqdd) const;
   // Row a of the free coordinates: its place among u (>= 0), or -1 - its place among v.
   std::vector<int> free_place_;
   // The structure of B = [I; -Jv^-1 Ju] over the free coordinates: the u columns row a can be
@@ -89,6 +94,18 @@ class ReducedDynamics {
   // corner's two or three of the car's fourteen). M [B beta], B^T M B and the products with B
   // run over these only.
   std::vector<std::vector<int>> b_cols_;
+  // The same by rows for the tangent's loops: an independent row's coordinate q and its column
+  // (B's entry 1); a dependent row's entries, coordinate q, column c and the entry's place b in
+  // B (column-major); and the dependent rows' free row a with their place among v.
+  struct IndependentRow {
+    int q, place;
+  };
+  struct DependentEntry {
+    int q, c, b;
+  };
+  std::vector<IndependentRow> independent_rows_;
+  std::vector<DependentEntry> dependent_entries_;
+  std::vector<std::pair<int, int>> dependent_rows_;
   // [B beta] by rows of q: row j's entries s_start_[j] .. s_start_[j + 1] - 1, at columns s_col_
   // (nu: beta); free row of coordinate j (-1: driven).
   std::vector<int> s_start_, s_col_, free_row_of_;
