@@ -104,24 +104,27 @@ TEST(EmitCpp, CompiledFunctionsAgreeWithTheInterpreter) {
         EXPECT_TRUE(testing::close(got[j], expected[j], 1e-11)) << "output " << j << ": " << got[j] << " vs " << expected[j];
       }
     }
-    // Tangent: nd directions, seeds direction-major.
-    const int nd = 3;
+    // Tangent: nd directions, seeds direction-major; directions run two at a time, so one, an
+    // even count and an odd count past one (a pair, then a last direction paired with zero seeds).
     const std::size_t m = list.outputs().size();
-    std::vector<double> seed_q(4 * nd), seed_qd(4 * nd);
-    seed_q = testing::random_values(4 * nd, point + 50);
-    seed_qd = testing::random_values(4 * nd, point + 60);
-    std::vector<double> out(m), dout(m * nd);
-    f_tangent(q, qd, p, nd, seed_q.data(), seed_qd.data(), out.data(), dout.data());
-    const Tape tape(tangent);
-    const ArrayId dq = ctx.seed_array(model.q), dqd = ctx.seed_array(model.qd);
-    for (int d = 0; d < nd; ++d) {
-      x.values[dq].assign(seed_q.begin() + 4 * d, seed_q.begin() + 4 * d + 4);
-      x.values[dqd].assign(seed_qd.begin() + 4 * d, seed_qd.begin() + 4 * d + 4);
-      const auto expected = testing::run(tape, x);
-      for (std::size_t j = 0; j < m; ++j) {
-        EXPECT_TRUE(testing::close(out[j], expected[j], 1e-11));
-        EXPECT_TRUE(testing::close(dout[d * m + j], expected[m + j], 1e-11))
-            << "direction " << d << " output " << j << ": " << dout[d * m + j] << " vs " << expected[m + j];
+    for (const int nd : {1, 2, 3, 6}) {
+      std::vector<double> seed_q(4 * nd), seed_qd(4 * nd);
+      seed_q = testing::random_values(4 * nd, point + 50);
+      seed_qd = testing::random_values(4 * nd, point + 60);
+      std::vector<double> out(m), dout(m * nd);
+      f_tangent(q, qd, p, nd, seed_q.data(), seed_qd.data(), out.data(), dout.data());
+      const Tape tape(tangent);
+      const ArrayId dq = ctx.seed_array(model.q), dqd = ctx.seed_array(model.qd);
+      for (int d = 0; d < nd; ++d) {
+        x.values[dq].assign(seed_q.begin() + 4 * d, seed_q.begin() + 4 * d + 4);
+        x.values[dqd].assign(seed_qd.begin() + 4 * d, seed_qd.begin() + 4 * d + 4);
+        const auto expected = testing::run(tape, x);
+        for (std::size_t j = 0; j < m; ++j) {
+          EXPECT_TRUE(testing::close(out[j], expected[j], 1e-11));
+          EXPECT_TRUE(testing::close(dout[d * m + j], expected[m + j], 1e-11))
+              << nd << " directions, direction " << d << " output " << j << ": " << dout[d * m + j] << " vs "
+              << expected[m + j];
+        }
       }
     }
   }
