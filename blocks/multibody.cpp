@@ -62,10 +62,17 @@ class Multibody : public Block {
     declare_output("qdd", g_.n, "m/s^2 or rad/s^2");
     set_output_reads(0, driven_motion);
     set_output_reads(1, driven_motion);
+    int group_size[2] = {0, 0};
     for (int s = 0; s < g_.sensor_count; ++s) {
       declare_output(g_.sensor_ports[s], g_.sensor_widths[s], g_.sensor_units ? g_.sensor_units[s] : "");
       if (!g_.sensor_reads_acceleration[s]) set_output_reads(3 + s, driven_motion);
+      const int group = g_.sensor_reads_acceleration[s] ? 1 : 0;
+      sensor_group_.push_back(group);
+      sensor_offset_.push_back(group_size[group]);
+      group_size[group] += g_.sensor_widths[s];
     }
+    group_outputs_[0] = group_size[0];
+    group_outputs_[1] = group_size[1];
     // Nominal magnitudes: a suspension's travel and a body's attitude, 0.01 m or rad, moving at
     // 0.1 m/s or rad/s (a scene's `nominal:` map sets others, e.g. for a wheel's spin angle).
     std::vector<std::string> states;
@@ -108,14 +115,16 @@ class Multibody : public Block {
     if (output_ready(e, 1)) std::copy_n(r.qd.data(), n, y[1]);
     if (output_ready(e, 2)) std::copy_n(r.qdd.data(), n, y[2]);
     if (g_.sensor_count == 0) return;
-    std::vector<double> out(std::max(1, g_.sensor_outputs));
     const Vector lam = padded(r.lam);
     const Vector inp = inputs(e);
-    g_.sensors(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), inp.data(), parameters(e), out.data());
-    int at = 0;
-    for (int s = 0; s < g_.sensor_count; ++s) {
-      if (output_ready(e, 3 + s)) std::copy_n(out.data() + at, g_.sensor_widths[s], y[3 + s]);
-      at += g_.sensor_widths[s];
+    for (int group = 0; group < 2; ++group) {
+      if (!sensor_group_ready(e, group)) continue;
+      std::vector<double> out(std::max(1, group_outputs_[group]));
+      (group ? g_.sensors_acceleration : g_.sensors_kinematic)(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(),
+                                                                inp.data(), parameters(e), out.data());
+      for (int s = 0; s < g_.sensor_count; ++s)
+        if (sensor_group_[s] == group && output_ready(e, 3 + s))
+          std::copy_n(out.data() + sensor_offset_[s], g_.sensor_widths[s], y[3 + s]);
     }
   }
 
@@ -133,18 +142,19 @@ class Multibody : public Block {
         if (acceleration) dy[2](i, d) = dqdd(i, d);
       }
     if (g_.sensor_count == 0 || nd == 0) return;
-    const int ns = g_.sensor_outputs;
-    std::vector<double> out(std::max(1, ns)), dout(static_cast<std::size_t>(std::max(1, ns)) * nd);
     const Vector lam = padded(r.lam);
     const Vector inp = inputs(e);
-    g_.sensors_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), inp.data(), parameters(e), nd, dq.data(),
-                       dqd.data(), dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
-    int at = 0;
-    for (int k = 0; k < g_.sensor_count; ++k) {
-      if (output_ready(e, 3 + k))
-        for (int d = 0; d < nd; ++d)
-          for (int i = 0; i < g_.sensor_widths[k]; ++i) dy[3 + k](i, d) = dout[d * ns + at + i];
-      at += g_.sensor_widths[k];
+    for (int group = 0; group < 2; ++group) {
+      if (!sensor_group_ready(e, group)) continue;
+      const int ns = group_outputs_[group];
+      std::vector<double> out(std::max(1, ns)), dout(static_cast<std::size_t>(std::max(1, ns)) * nd);
+      (group ? g_.sensors_acceleration_tangent : g_.sensors_kinematic_tangent)(
+          r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), inp.data(), parameters(e), nd, dq.data(), dqd.data(),
+          dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
+      for (int k = 0; k < g_.sensor_count; ++k)
+        if (sensor_group_[k] == group && output_ready(e, 3 + k))
+          for (int d = 0; d < nd; ++d)
+            for (int i = 0; i < g_.sensor_widths[k]; ++i) dy[3 + k](i, d) = dout[d * ns + sensor_offset_[k] + i];
     }
   }
 
@@ -171,6 +181,13 @@ class Multibody : public Block {
 
  private:
   Vector padded(const Vector& v) const { return v.size() ? v : Vector::Zero(1); }
+
+  // Whether this call sets a sensor port of the group (0: positions and velocities, 1: reads qdd).
+  bool sensor_group_ready(const Eval& e, int group) const {
+    for (int s = 0; s < g_.sensor_count; ++s)
+      if (sensor_group_[s] == group && output_ready(e, 3 + s)) return true;
+    return false;
+  }
 
   const double* parameters(const Eval& e) const {
     return exposed_ && g_.parameters ? e.p : (g_.parameters ? g_.parameter_values : zero_);
@@ -319,6 +336,9 @@ class Multibody : public Block {
 
   const GeneratedModel& g_;
   std::vector<int> load_offsets_;  ///< each load's first entry in the model's input array
+  /// Each sensor port's group (1: reads qdd) and first entry among its group's outputs.
+  std::vector<int> sensor_group_, sensor_offset_;
+  int group_outputs_[2] = {0, 0};
   ReducedDynamics reduced_;
   bool exposed_;
   const double zero_[1] = {0.0};

@@ -105,6 +105,13 @@ std::vector<int> choose_independent(const mbs::Model& model, bool& automatic) {
   return u;
 }
 
+// Whether a sensor's outputs depend on qdd: acceleration sensors, and joint sensors that report
+// the joint's acceleration.
+bool reads_acceleration(const mbs::Sensor& sensor) {
+  const bool reads_qdd = std::find(sensor.components.begin(), sensor.components.end(), 2) != sensor.components.end();
+  return sensor.type == mbs::Sensor::Type::Acceleration || (sensor.type == mbs::Sensor::Type::Joint && reads_qdd);
+}
+
 }  // namespace
 
 MbsGeneration generate_mbs(const std::string& model_path, const GenerationOptions& options) {
@@ -189,6 +196,23 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   kinematics.push_back(tangent(name + "_velocity_constraints_tangent", *lists.velocity_constraints, all_seeded));
   sensors.push_back(plain(name + "_sensors", *lists.sensors));
   sensors.push_back(tangent(name + "_sensors_tangent", *lists.sensors, all_seeded));
+  // The sensors in two groups, for a block that asks for positions and velocities before the
+  // loads are known and for accelerations after: each call computes its own group only.
+  for (const bool acceleration : {false, true}) {
+    EquationList group(lists.sensors->context());
+    for (const auto& a : lists.sensors->assignments()) group.append(a);
+    std::size_t at = 0;
+    for (const auto& sensor : model.sensors) {
+      const std::size_t width = static_cast<std::size_t>(sensor.width());
+      if (reads_acceleration(sensor) == acceleration)
+        for (std::size_t k = 0; k < width; ++k) group.add_output(lists.sensors->outputs()[at + k]);
+      at += width;
+    }
+    const EquationList reduced = symbolic::eliminate(group);
+    const std::string fn = name + (acceleration ? "_sensors_acceleration" : "_sensors_kinematic");
+    sensors.push_back(plain(fn, reduced));
+    sensors.push_back(tangent(fn + "_tangent", reduced, all_seeded));
+  }
   for (const auto& j : lists.jacobians) sensors.push_back(plain(j.name, *j.list));
 
   bool automatic = false;
@@ -237,9 +261,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
     sensor_ports.push_back(sensor.name);
     sensor_units.push_back(sensor_unit(model, sensor));
     sensor_widths.push_back(sensor.width());
-    const bool reads_qdd = std::find(sensor.components.begin(), sensor.components.end(), 2) != sensor.components.end();
-    sensor_acc.push_back(sensor.type == mbs::Sensor::Type::Acceleration ||
-                         (sensor.type == mbs::Sensor::Type::Joint && reads_qdd));
+    sensor_acc.push_back(reads_acceleration(sensor));
   }
   std::vector<std::string> load_names;
   std::vector<int> load_widths;
@@ -290,7 +312,9 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += "    " + std::to_string(model.load_input_count()) + ", load_names, load_widths, sensor_units,\n";
   d += "    jacobian_nonzero, " + name + "_constraints_tangent,\n";
   d += "    " + std::to_string(mass_rows.size()) + ", mass_rows, mass_cols, " +
-       (lists.mass_matrix ? name + "_mass_matrix" : std::string("nullptr")) + ",\n    parameter_units};\n\n";
+       (lists.mass_matrix ? name + "_mass_matrix" : std::string("nullptr")) + ",\n    parameter_units,\n";
+  d += "    " + name + "_sensors_kinematic, " + name + "_sensors_kinematic_tangent, " + name + "_sensors_acceleration, " +
+       name + "_sensors_acceleration_tangent};\n\n";
   d += "}  // namespace dydp::generated\n";
   write_atomically(options.out_dir / (name + "_model.cpp"), d);
   return result;

@@ -70,6 +70,14 @@ struct GeneratedModel {
   const int* mass_cols;
   GeneratedFunction mass_matrix;
   const char* const* parameter_units;  // SI unit of each symbolic parameter ("" if the model gives none)
+  // The sensors in two groups, each writing its ports' outputs in port order as `sensors` does:
+  // the ports that do not read qdd (sensor_reads_acceleration 0; their tangent's qdd seeds are
+  // not read) and those that do. A block asked for positions before the loads are known, and
+  // for accelerations after, computes each group once.
+  GeneratedFunction sensors_kinematic;
+  GeneratedTangent sensors_kinematic_tangent;
+  GeneratedFunction sensors_acceleration;
+  GeneratedTangent sensors_acceleration_tangent;
 };
 
 }  // namespace dydp::mbs

@@ -104,6 +104,54 @@ TEST_P(Generated, EveryFunctionMatchesTheOracle) {
   }
 }
 
+// The two sensor groups (ports that do not read qdd, ports that do) are the full sensors'
+// outputs split by port, in port order: values and tangents (three directions, seeded on every
+// array) agree entry by entry with `sensors` and `sensors_tangent`, and every output is in
+// exactly one group.
+TEST_P(Generated, SensorGroupsAreTheSensorsSplitByPort) {
+  Fixture f(GetParam());
+  ASSERT_NE(f.g, nullptr);
+  const GeneratedModel& g = *f.g;
+  if (g.sensor_outputs == 0) GTEST_SKIP() << "no sensors";
+  std::mt19937 rng(11);
+  const Args a = random_args(rng, g, f.p);
+  const int nd = 3, ns = g.sensor_outputs;
+  auto seeds = [&](int size) { return Vector(random_vector(rng, std::max(1, size) * nd, 1.0)); };
+  const Vector sq = seeds(g.n), sqd = seeds(g.n), sqdd = seeds(g.n), sinp = seeds(g.inputs), sp = seeds(g.parameters);
+  auto tangent = [&](GeneratedTangent fn, int size) {
+    std::vector<double> out(std::max(1, size)), dout(static_cast<std::size_t>(std::max(1, size)) * nd);
+    fn(a.q.data(), a.qd.data(), a.qdd.data(), a.lam.data(), a.inp.data(), a.p.data(), nd, sq.data(), sqd.data(),
+       sqdd.data(), sinp.data(), sp.data(), out.data(), dout.data());
+    return std::make_pair(out, dout);
+  };
+  const Vector full = generated_outputs(g.sensors, ns, a);
+  const auto [full_out, full_dout] = tangent(g.sensors_tangent, ns);
+  int group_size[2] = {0, 0};
+  for (int k = 0; k < g.sensor_count; ++k) group_size[g.sensor_reads_acceleration[k] ? 1 : 0] += g.sensor_widths[k];
+  ASSERT_EQ(group_size[0] + group_size[1], ns);
+  const Vector value[2] = {generated_outputs(g.sensors_kinematic, group_size[0], a),
+                           generated_outputs(g.sensors_acceleration, group_size[1], a)};
+  const auto kinematic = tangent(g.sensors_kinematic_tangent, group_size[0]);
+  const auto acceleration = tangent(g.sensors_acceleration_tangent, group_size[1]);
+  const std::pair<std::vector<double>, std::vector<double>>* group_tangent[2] = {&kinematic, &acceleration};
+  int at = 0, in_group[2] = {0, 0};
+  for (int k = 0; k < g.sensor_count; ++k) {
+    const int group = g.sensor_reads_acceleration[k] ? 1 : 0;
+    for (int i = 0; i < g.sensor_widths[k]; ++i, ++at) {
+      const int j = in_group[group]++;
+      const std::string what = std::string(g.sensor_names[at]) + (group ? " (acceleration group)" : " (kinematic group)");
+      EXPECT_NEAR(value[group][j], full[at], 1e-12 * (1.0 + std::abs(full[at]))) << what;
+      EXPECT_NEAR(group_tangent[group]->first[j], full_out[at], 1e-12 * (1.0 + std::abs(full_out[at]))) << what;
+      for (int d = 0; d < nd; ++d) {
+        const double expected = full_dout[static_cast<std::size_t>(d) * ns + at];
+        EXPECT_NEAR(group_tangent[group]->second[static_cast<std::size_t>(d) * group_size[group] + j], expected,
+                    1e-12 * (1.0 + std::abs(expected)))
+            << what << ", direction " << d;
+      }
+    }
+  }
+}
+
 // A consistent random state near the initial configuration: independent coordinates and
 // velocities, inputs (driven motions near their initial values), parameters.
 struct DynamicsCase {
