@@ -120,8 +120,17 @@ class Multibody : public Block {
     for (int group = 0; group < 2; ++group) {
       if (!sensor_group_ready(e, group)) continue;
       std::vector<double> out(std::max(1, group_outputs_[group]));
-      (group ? g_.sensors_acceleration : g_.sensors_kinematic)(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(),
-                                                                inp.data(), parameters(e), out.data());
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (group == 0 && kinematic_sensor_values_.point == kinematic_point_ &&
+            kinematic_sensor_values_.values.size() == out.size()) {
+          out = kinematic_sensor_values_.values;
+        } else {
+          (group ? g_.sensors_acceleration : g_.sensors_kinematic)(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(),
+                                                                    inp.data(), parameters(e), out.data());
+          if (group == 0) kinematic_sensor_values_ = {kinematic_point_, {}, {}, {}, out};
+        }
+      }
       for (int s = 0; s < g_.sensor_count; ++s)
         if (sensor_group_[s] == group && output_ready(e, 3 + s))
           std::copy_n(out.data() + sensor_offset_[s], g_.sensor_widths[s], y[3 + s]);
@@ -148,9 +157,21 @@ class Multibody : public Block {
       if (!sensor_group_ready(e, group)) continue;
       const int ns = group_outputs_[group];
       std::vector<double> out(std::max(1, ns)), dout(static_cast<std::size_t>(std::max(1, ns)) * nd);
-      (group ? g_.sensors_acceleration_tangent : g_.sensors_kinematic_tangent)(
-          r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), inp.data(), parameters(e), nd, dq.data(), dqd.data(),
-          dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
+      {
+        // the kinematic group depends on what the kinematic tangent does (q, qd, the driven
+        // joints' motion, p): kept with it, and reused while it is
+        std::lock_guard<std::mutex> lock(mutex_);
+        KeptSensors& kept = kinematic_sensor_tangent_;
+        if (group == 0 && kept.point == kinematic_point_ && same(kept.dq, dq) && same(kept.dqd, dqd) &&
+            same(kept.dp, dp) && kept.values.size() == dout.size()) {
+          dout = kept.values;
+        } else {
+          (group ? g_.sensors_acceleration_tangent : g_.sensors_kinematic_tangent)(
+              r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), inp.data(), parameters(e), nd, dq.data(), dqd.data(),
+              dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
+          if (group == 0) kept = {kinematic_point_, dq, dqd, dp, dout};
+        }
+      }
       for (int k = 0; k < g_.sensor_count; ++k)
         if (sensor_group_[k] == group && output_ready(e, 3 + k))
           for (int d = 0; d < nd; ++d)
@@ -181,6 +202,7 @@ class Multibody : public Block {
 
  private:
   Vector padded(const Vector& v) const { return v.size() ? v : Vector::Zero(1); }
+  static bool same(const Matrix& a, const Matrix& b) { return a.rows() == b.rows() && a.cols() == b.cols() && a == b; }
 
   // Whether this call sets a sensor port of the group (0: positions and velocities, 1: reads qdd).
   bool sensor_group_ready(const Eval& e, int group) const {
@@ -333,6 +355,13 @@ class Multibody : public Block {
     Matrix du, dud, dinp, dp;  ///< seeds
     Matrix dq, dqd, dqdd;      ///< result
   };
+  /// The kinematic sensors (values, or derivatives for the kept dq, dqd, dp) at a kinematic
+  /// point: an output pass sets them in its first call and again in its last.
+  struct KeptSensors {
+    long point = -1;
+    Matrix dq, dqd, dp;
+    std::vector<double> values;
+  };
 
   const GeneratedModel& g_;
   std::vector<int> load_offsets_;  ///< each load's first entry in the model's input array
@@ -349,6 +378,7 @@ class Multibody : public Block {
   mutable long point_ = 0;            ///< changes whenever result_ does
   mutable long kinematic_point_ = 0;  ///< changes whenever result_'s kinematics do
   mutable KeptTangent kinematic_tangent_, full_tangent_;
+  mutable KeptSensors kinematic_sensor_values_, kinematic_sensor_tangent_;
 };
 
 std::vector<engine::ParamSpec> exposed_parameters(const GeneratedModel& g) {
