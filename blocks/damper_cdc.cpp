@@ -101,7 +101,16 @@ struct PointTangent {
   double pdot_reb, pdot_comp, pdot_res, qdot, force, power;
 };
 
-PointTangent tangent(const Eval& e, const Point& o, const Seeds& s, int d, bool with_inputs) {
+/// The logarithms the tangent reads, the same for every direction: ln(A_soft / A_hard) and
+/// ln(p0 / p_res).
+struct TangentLogs {
+  double section_ratio, precharge_ratio;
+};
+TangentLogs tangent_logs(const Eval& e) {
+  return {std::log(e.p[kSectionSoft] / e.p[kSectionHard]), std::log(e.p[kPrecharge] / e.x[kPRes])};
+}
+
+PointTangent tangent(const Eval& e, const Point& o, const TangentLogs& logs, const Seeds& s, int d, bool with_inputs) {
   const double* p = e.p;
   const double* x = e.x;
   const auto dp = [&](int j) { return s.p(j, d); };
@@ -111,7 +120,7 @@ PointTangent tangent(const Eval& e, const Point& o, const Seeds& s, int d, bool 
   const double d_area_rod = std::numbers::pi / 2 * p[kRodDiameter] * dp(kRodDiameter);
   const double d_area_annulus = d_area_piston - d_area_rod;
   const double d_xi = dp(kCurrent) / (kCurrentMax - kCurrentMin);
-  const double log_ratio = std::log(p[kSectionSoft] / p[kSectionHard]);
+  const double log_ratio = logs.section_ratio;
   const double d_valve_section =
       o.valve_section * ((1 - o.xi) * dp(kSectionHard) / p[kSectionHard] +
                          o.xi * dp(kSectionSoft) / p[kSectionSoft] + log_ratio * d_xi);
@@ -135,7 +144,7 @@ PointTangent tangent(const Eval& e, const Point& o, const Seeds& s, int d, bool 
   const double d_port_dp = o.port.dp_q * dx_q + o.port.dp_k * dk_port + o.port.dp_pt * dpt;
   // V_gas = V_g0 (p0 / p_res)^(1/n)
   const double n = p[kPolytropic];
-  const double log_p = std::log(p[kPrecharge] / x[kPRes]);
+  const double log_p = logs.precharge_ratio;
   const double d_v_gas = o.v_gas * (dp(kGasVolume) / p[kGasVolume] +
                                     (dp(kPrecharge) / p[kPrecharge] - dx_res / x[kPRes]) / n -
                                     dp(kPolytropic) / (n * n) * log_p);
@@ -220,8 +229,9 @@ class DamperCdc : public Block {
     }
     if (!e.inputs_ready) return;
     const Point o = evaluate(e, true);
+    const TangentLogs logs = tangent_logs(e);
     for (int d = 0; d < s.directions; ++d) {
-      const PointTangent t = tangent(e, o, s, d, true);
+      const PointTangent t = tangent(e, o, logs, s, d, true);
       dy[kForce](0, d) = t.force;
       dy[kPower](0, d) = t.power;
     }
@@ -235,8 +245,9 @@ class DamperCdc : public Block {
   }
   void derivatives_tangent(const Eval& e, const Seeds& s, DirView dxdot) const override {
     const Point o = evaluate(e, true);
+    const TangentLogs logs = tangent_logs(e);
     for (int d = 0; d < s.directions; ++d) {
-      const PointTangent t = tangent(e, o, s, d, true);
+      const PointTangent t = tangent(e, o, logs, s, d, true);
       dxdot(kPReb, d) = t.pdot_reb;
       dxdot(kPComp, d) = t.pdot_comp;
       dxdot(kPRes, d) = t.pdot_res;
