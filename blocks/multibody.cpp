@@ -67,6 +67,7 @@ class Multibody : public Block {
       declare_output(g_.sensor_ports[s], g_.sensor_widths[s], g_.sensor_units ? g_.sensor_units[s] : "");
       if (!g_.sensor_reads_acceleration[s]) set_output_reads(3 + s, driven_motion);
       const int group = g_.sensor_reads_acceleration[s] ? 1 : 0;
+      if (group_port_[group] < 0) group_port_[group] = s;
       sensor_group_.push_back(group);
       sensor_offset_.push_back(group_size[group]);
       group_size[group] += g_.sensor_widths[s];
@@ -132,8 +133,7 @@ class Multibody : public Block {
         }
       }
       for (int s = 0; s < g_.sensor_count; ++s)
-        if (sensor_group_[s] == group && output_ready(e, 3 + s))
-          std::copy_n(out.data() + sensor_offset_[s], g_.sensor_widths[s], y[3 + s]);
+        if (sensor_group_[s] == group) std::copy_n(out.data() + sensor_offset_[s], g_.sensor_widths[s], y[3 + s]);
     }
   }
 
@@ -173,7 +173,7 @@ class Multibody : public Block {
         }
       }
       for (int k = 0; k < g_.sensor_count; ++k)
-        if (sensor_group_[k] == group && output_ready(e, 3 + k))
+        if (sensor_group_[k] == group)
           for (int d = 0; d < nd; ++d)
             for (int i = 0; i < g_.sensor_widths[k]; ++i) dy[3 + k](i, d) = dout[d * ns + sensor_offset_[k] + i];
     }
@@ -204,11 +204,10 @@ class Multibody : public Block {
   Vector padded(const Vector& v) const { return v.size() ? v : Vector::Zero(1); }
   static bool same(const Matrix& a, const Matrix& b) { return a.rows() == b.rows() && a.cols() == b.cols() && a == b; }
 
-  // Whether this call sets a sensor port of the group (0: positions and velocities, 1: reads qdd).
+  // Whether this call sets the group's sensor ports (0: positions and velocities, 1: reads
+  // qdd): the ports of a group read the same inputs, so one port answers for all.
   bool sensor_group_ready(const Eval& e, int group) const {
-    for (int s = 0; s < g_.sensor_count; ++s)
-      if (sensor_group_[s] == group && output_ready(e, 3 + s)) return true;
-    return false;
+    return group_port_[group] >= 0 && output_ready(e, 3 + group_port_[group]);
   }
 
   const double* parameters(const Eval& e) const {
@@ -236,9 +235,7 @@ class Multibody : public Block {
   // sensors); the call for positions and velocities comes first, before the loads are known.
   bool needs_dynamics(const Eval& e) const {
     if (output_ready(e, 2)) return true;
-    for (int k = 0; k < g_.sensor_count; ++k)
-      if (g_.sensor_reads_acceleration[k] && output_ready(e, 3 + k)) return true;
-    return false;
+    return sensor_group_ready(e, 1);
   }
 
   // The partitioned dynamics at (x, inputs, p) in two halves, each reused while its own
@@ -368,6 +365,7 @@ class Multibody : public Block {
   /// Each sensor port's group (1: reads qdd) and first entry among its group's outputs.
   std::vector<int> sensor_group_, sensor_offset_;
   int group_outputs_[2] = {0, 0};
+  int group_port_[2] = {-1, -1};  ///< a sensor port of each group (-1: none)
   ReducedDynamics reduced_;
   bool exposed_;
   const double zero_[1] = {0.0};

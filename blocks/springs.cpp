@@ -38,9 +38,16 @@ double stops(const double* p, double delta) {
   return p[kBumpStiffness] * smooth_pos(delta - p[kBumpClearance], p[kStopWidth]).value -
          p[kReboundStiffness] * smooth_pos(-delta - p[kReboundClearance], p[kStopWidth]).value;
 }
-double stops_tangent(const double* p, double delta, const Seeds& s, double d_delta, int d) {
-  const Pos b = smooth_pos(delta - p[kBumpClearance], p[kStopWidth]);
-  const Pos r = smooth_pos(-delta - p[kReboundClearance], p[kStopWidth]);
+/// The two stops' smooth contact at a deflection, the same for every direction of a tangent.
+struct Stops {
+  Pos bump, rebound;
+};
+Stops stops_at(const double* p, double delta) {
+  return {smooth_pos(delta - p[kBumpClearance], p[kStopWidth]), smooth_pos(-delta - p[kReboundClearance], p[kStopWidth])};
+}
+double stops_tangent(const double* p, const Stops& at, const Seeds& s, double d_delta, int d) {
+  const Pos& b = at.bump;
+  const Pos& r = at.rebound;
   const double dw = s.p(kStopWidth, d);
   return s.p(kBumpStiffness, d) * b.value +
          p[kBumpStiffness] * (b.dz * (d_delta - s.p(kBumpClearance, d)) + b.dw * dw) -
@@ -60,10 +67,10 @@ class Spring : public Block {
   }
   void outputs_tangent(const Eval& e, const Seeds& s, const DirView* dy) const override {
     const double delta = e.u[0][0];
+    const Stops at = stops_at(e.p, delta);
     for (int d = 0; d < s.directions; ++d) {
       const double d_delta = s.u[0](0, d);
-      dy[0](0, d) = s.p(kPreload, d) + law_tangent(e.p, delta, s, d_delta, d) +
-                    stops_tangent(e.p, delta, s, d_delta, d);
+      dy[0](0, d) = s.p(kPreload, d) + law_tangent(e.p, delta, s, d_delta, d) + stops_tangent(e.p, at, s, d_delta, d);
     }
   }
 
