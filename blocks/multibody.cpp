@@ -129,7 +129,10 @@ class Multibody : public Block {
         } else {
           (group ? g_.sensors_acceleration : g_.sensors_kinematic)(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(),
                                                                     inp.data(), parameters(e), out.data());
-          if (group == 0) kinematic_sensor_values_ = {kinematic_point_, {}, {}, {}, out};
+          if (group == 0) {
+            kinematic_sensor_values_.point = kinematic_point_;
+            kinematic_sensor_values_.values = out;
+          }
         }
       }
       for (int s = 0; s < g_.sensor_count; ++s)
@@ -169,7 +172,7 @@ class Multibody : public Block {
           (group ? g_.sensors_acceleration_tangent : g_.sensors_kinematic_tangent)(
               r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), inp.data(), parameters(e), nd, dq.data(), dqd.data(),
               dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
-          if (group == 0) kept = {kinematic_point_, dq, dqd, dp, dout};
+          if (group == 0) kept.assign(kinematic_point_, dq, dqd, dp, dout);
         }
       }
       for (int k = 0; k < g_.sensor_count; ++k)
@@ -336,14 +339,14 @@ class Multibody : public Block {
     } else {
       reduced_.tangent_kinematics(r, in.data(), parameters(e), nd, du.data(), dud.data(), dinp.data(), dp.data(), dq,
                                   dqd);
-      kinematic_tangent_ = {kinematic_point_, du, dud, driven, dp, dq, dqd, {}};
+      kinematic_tangent_.assign(kinematic_point_, du, dud, driven, dp, dq, dqd, nullptr);
     }
     if (!dynamics) {
       dqdd = Matrix::Zero(g_.n, std::max(nd, 1));  // not read: no acceleration output in this call
       return;
     }
     reduced_.tangent_dynamics(r, in.data(), parameters(e), nd, dinp.data(), dp.data(), dq, dqd, dqdd);
-    full_tangent_ = {point_, du, dud, dinp, dp, dq, dqd, dqdd};
+    full_tangent_.assign(point_, du, dud, dinp, dp, dq, dqd, &dqdd);
   }
 
   /// A tangent kept for the next call at the same point with the same seeds.
@@ -351,6 +354,13 @@ class Multibody : public Block {
     long point = -1;
     Matrix du, dud, dinp, dp;  ///< seeds
     Matrix dq, dqd, dqdd;      ///< result
+    // (member by member: a matrix of the same size keeps its storage)
+    void assign(long at, const Matrix& du_, const Matrix& dud_, const Matrix& dinp_, const Matrix& dp_,
+                const Matrix& dq_, const Matrix& dqd_, const Matrix* dqdd_) {
+      point = at, du = du_, dud = dud_, dinp = dinp_, dp = dp_, dq = dq_, dqd = dqd_;
+      if (dqdd_) dqdd = *dqdd_;
+      else dqdd.resize(0, 0);
+    }
   };
   /// The kinematic sensors (values, or derivatives for the kept dq, dqd, dp) at a kinematic
   /// point: an output pass sets them in its first call and again in its last.
@@ -358,6 +368,9 @@ class Multibody : public Block {
     long point = -1;
     Matrix dq, dqd, dp;
     std::vector<double> values;
+    void assign(long at, const Matrix& dq_, const Matrix& dqd_, const Matrix& dp_, const std::vector<double>& v) {
+      point = at, dq = dq_, dqd = dqd_, dp = dp_, values = v;
+    }
   };
 
   const GeneratedModel& g_;
