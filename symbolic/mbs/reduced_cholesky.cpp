@@ -5,7 +5,7 @@
 
 namespace dydp::mbs {
 
-bool ReducedCholesky::compute(const Matrix& A) {
+bool ReducedCholesky::compute(const Eigen::Ref<const Matrix>& A) {
   n_ = static_cast<int>(A.rows());
   if (n_ > kSmall) {
     large_.compute(A);  // (which takes a NaN pivot for a positive one)

@@ -16,7 +16,7 @@ class ReducedCholesky {
 
   // Factors the symmetric positive definite A (its lower triangle is read). False when A is not
   // positive definite (a pivot not positive, or not finite).
-  bool compute(const Matrix& A);
+  bool compute(const Eigen::Ref<const Matrix>& A);
   // x := A^-1 x for `nrhs` columns of length size(), column-major with leading dimension ld.
   void solve_in_place(double* x, Eigen::Index ld, Eigen::Index nrhs) const;
   template <typename Derived>

@@ -52,7 +52,7 @@ ReducedDynamics::ReducedDynamics(const GeneratedModel& model) : model_(model), p
     if (free_place_[a] < 0) dependent_rows_.emplace_back(static_cast<int>(a), -1 - free_place_[a]);
     if (free_place_[a] >= 0) independent_rows_.push_back({f_[a], free_place_[a]});
     else
-      for (int c : b_cols_[a]) dependent_entries_.push_back({f_[a], c, c * static_cast<int>(f_.size()) + static_cast<int>(a)});
+      for (int c : b_cols_[a]) dependent_entries_.push_back({f_[a], c, static_cast<int>(a) * nu + c});
   }
   s_start_.assign(1, 0);
   for (int j = 0; j < n; ++j) {
@@ -174,16 +174,19 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
       for (int t = s_start_[j]; t < s_start_[j + 1]; ++t) w.s_val[t] = s_col_[t] < nu ? r.B(a, s_col_[t]) : w.beta[a];
     }
     r.MB.setZero();
-    double* mb = r.MB.data();
+    double* mb = r.MB.data();  // row-major: entry (i, c) at i * k + c
     const int* start = s_start_.data();
     const int* col = s_col_.data();
     const double* val = w.s_val.data();
     for (int e = 0; e < model_.mass_entries; ++e) {
       const int i = model_.mass_rows[e], j = model_.mass_cols[e];
       const double v = w.mass[e];
-      for (int t = start[j]; t < start[j + 1]; ++t) mb[col[t] * n + i] += v * val[t];
-      if (i != j)
-        for (int t = start[i]; t < start[i + 1]; ++t) mb[col[t] * n + j] += v * val[t];
+      double* row_i = mb + static_cast<Eigen::Index>(i) * k;
+      for (int t = start[j]; t < start[j + 1]; ++t) row_i[col[t]] += v * val[t];
+      if (i != j) {
+        double* row_j = mb + static_cast<Eigen::Index>(j) * k;
+        for (int t = start[i]; t < start[i + 1]; ++t) row_j[col[t]] += v * val[t];
+      }
     }
   } else {
     // the inertial pass seeded on [B beta] (nu + 1 directions; M itself, n directions, is never
@@ -194,7 +197,10 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
       if (m > 0) r.seeds(f_[a], nu) = w.beta[a];
     }
     w.out.resize(n);
-    model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, k, r.seeds.data(), w.out.data(), r.MB.data());
+    w.mass_columns.resize(n, k);
+    model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, k, r.seeds.data(), w.out.data(),
+                w.mass_columns.data());
+    r.MB = w.mass_columns;
   }
 
   const bool whole = identity && nf == n;  // no driven joints either: M_ff B is M
@@ -207,14 +213,15 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
     w.cf[a] = c[f_[a]];
   }
   bool definite = false;
+  // (M_ff and B^T M_ff B are symmetric: a row-major copy read column-major is the same matrix)
   if (whole) {
-    definite = r.reduced.compute(r.MB);
+    definite = r.reduced.compute(Eigen::Map<const Matrix>(r.MB.data(), n, n));
   } else if (identity) {
-    definite = r.reduced.compute(r.MBf);
+    definite = r.reduced.compute(Eigen::Map<const Matrix>(r.MBf.data(), nf, nf));
   } else {
-    w.reduced.setZero(nu, nu);  // B^T M_ff B over B's structure
+    w.reduced.setZero(nu, nu);  // B^T M_ff B over B's structure, column by column
     for (int a = 0; a < nf; ++a)
-      for (int c : b_cols_[a]) w.reduced.row(c) += r.B(a, c) * r.MBf.row(a);
+      for (int c : b_cols_[a]) w.reduced.col(c) += r.B(a, c) * r.MBf.row(a).transpose();
     definite = r.reduced.compute(w.reduced);
   }
   if (!definite)
@@ -245,10 +252,10 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
 
 void ReducedDynamics::seed_arrays(int nd, const double* dinputs, const double* dp_in, Matrix& dinp, Matrix& dp,
                                   Matrix& dqdd) const {
-  dinp.setZero(std::max(1, model_.inputs), nd);
-  dp.setZero(std::max(1, model_.parameters), nd);
   if (dinputs && model_.inputs) dinp = Eigen::Map<const Matrix>(dinputs, model_.inputs, nd);
+  else dinp.setZero(std::max(1, model_.inputs), nd);
   if (dp_in && model_.parameters) dp = Eigen::Map<const Matrix>(dp_in, model_.parameters, nd);
+  else dp.setZero(std::max(1, model_.parameters), nd);
   dqdd.setZero(model_.n, nd);
   for (int d = 0; d < nd; ++d)
     for (std::size_t i = 0; i < d_.size(); ++i) dqdd(d_[i], d) = dinp(model_.load_inputs + 3 * i + 2, d);

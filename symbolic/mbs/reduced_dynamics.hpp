@@ -21,6 +21,9 @@ class ReducedDynamics {
  public:
   using Vector = Eigen::VectorXd;
   using Matrix = Eigen::MatrixXd;
+  // Row-major where the partitioning reads rows: B's and M [B beta]'s rows are gathered by
+  // coordinate.
+  using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
   explicit ReducedDynamics(const GeneratedModel& model);
   const GeneratedModel& model() const { return model_; }
@@ -30,19 +33,20 @@ class ReducedDynamics {
   struct Result {
     Vector q, qd, qdd, lam;
     Vector udd;
-    Matrix MB;                                    // M [B beta]: n x (nu + 1 if m > 0)
+    RowMatrix MB;                                 // M [B beta]: n x (nu + 1 if m > 0)
     Matrix J;                                     // m x n
     BlockLU Jv;                                   // dependent columns of J, loop by loop
-    Matrix B;                                     // free coordinates x nu
+    RowMatrix B;                                  // free coordinates x nu
     ReducedCholesky reduced;                      // B^T M_ff B
-    Matrix seeds, MBf;                            // [B beta] over q, M_ff B
+    Matrix seeds;                                 // [B beta] over q
+    RowMatrix MBf;                                // M_ff B
     int newton_iterations = 0;
     // Scratch storage sized at the first call and reused, so that a solve and its tangents
     // allocate nothing once the sizes are known (the right-hand side's path).
     struct Work {
       std::vector<double> hj, res, out, lam_zero, mass, s_val;
       Vector beta, cf, Mbeta, fv, qddf;
-      Matrix Ju, Bv, beta_v, reduced, MBv;
+      Matrix Ju, Bv, beta_v, reduced, MBv, mass_columns;
       Matrix dinp, dp, dqdd_seed, dout, dh, dv, dbeta_v, dudd;
     };
     mutable Work work;
