@@ -334,11 +334,13 @@ std::string one_line(std::string s) {
   return s;
 }
 
-// Abbreviations (S3, C3) the list reads, in node order.
-std::vector<NodeId> abbreviations_used(const EquationList& list) {
+// Depth first over the nodes reachable from the list's assignments and outputs (from `first`
+// on), each once; visit(n) returns whether to go on into n's children.
+template <typename Visit>
+void walk_list(const EquationList& list, std::size_t first_assignment, std::size_t first_output, Visit visit) {
   const Context& ctx = list.context();
   std::vector<char> seen(ctx.size(), 0);
-  std::vector<NodeId> stack, found;
+  std::vector<NodeId> stack;
   auto walk = [&](NodeId root) {
     stack.push_back(root);
     while (!stack.empty()) {
@@ -346,15 +348,23 @@ std::vector<NodeId> abbreviations_used(const EquationList& list) {
       stack.pop_back();
       if (seen[n]) continue;
       seen[n] = 1;
-      if (ctx.is_abbreviation(n)) {
-        found.push_back(n);
-        continue;
-      }
+      if (!visit(n)) continue;
       for (NodeId c : ctx.children(n)) stack.push_back(c);
     }
   };
-  for (const Assignment& a : list.assignments()) walk(a.value);
-  for (const Output& o : list.outputs()) walk(o.value);
+  for (std::size_t i = first_assignment; i < list.size(); ++i) walk(list.assignments()[i].value);
+  for (std::size_t j = first_output; j < list.outputs().size(); ++j) walk(list.outputs()[j].value);
+}
+
+// Abbreviations (S3, C3) the list reads, in node order.
+std::vector<NodeId> abbreviations_used(const EquationList& list) {
+  const Context& ctx = list.context();
+  std::vector<NodeId> found;
+  walk_list(list, 0, 0, [&](NodeId n) {
+    if (!ctx.is_abbreviation(n)) return true;
+    found.push_back(n);
+    return false;
+  });
   // by argument, sine before cosine: S2, C2, S3, C3
   std::sort(found.begin(), found.end(), [&](NodeId a, NodeId b) {
     const NodeId xa = ctx.children(a)[0], xb = ctx.children(b)[0];
@@ -362,6 +372,32 @@ std::vector<NodeId> abbreviations_used(const EquationList& list) {
     return ctx.op(a) == Op::Sin && ctx.op(b) != Op::Sin;
   });
   return found;
+}
+
+// The primal values (primal auxiliaries, sines and cosines, input and parameter elements) that a
+// tangent list's derivative part reads as arithmetic operands, each with its name as a pair
+// (`lane_RJ12_8`); conditions (select, sign) and function arguments are not entered.
+std::unordered_map<NodeId, std::string> primal_values_read(const EquationList& tangent) {
+  const Context& ctx = tangent.context();
+  std::vector<char> primal(ctx.size(), 0);
+  for (std::size_t i = 0; i < tangent.primal_assignments(); ++i) primal[tangent.assignments()[i].target] = 1;
+  std::unordered_map<NodeId, std::string> names;
+  walk_list(tangent, tangent.primal_assignments(), tangent.primal_outputs(), [&](NodeId x) {
+    const Op op = ctx.op(x);
+    if (ctx.is_abbreviation(x)) {
+      names.emplace(x, "lane_" + ctx.abbreviation_name(x));
+      return false;
+    }
+    if (op == Op::Symbol) {
+      const Symbol& sym = ctx.symbol(x);
+      if (sym.kind == SymbolKind::Aux && primal[x]) names.emplace(x, "lane_" + sym.name);
+      else if (sym.kind == SymbolKind::Input || sym.kind == SymbolKind::Parameter)
+        names.emplace(x, "lane_" + ctx.array(sym.array).name + "_" + std::to_string(sym.index));
+      return false;
+    }
+    return op == Op::Add || op == Op::Mul || op == Op::Neg || op == Op::Div;
+  });
+  return names;
 }
 
 void check_size(const EquationList& list, const EmitOptions& options) {
@@ -513,47 +549,13 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
   // with zero seeds and its partner's outputs go to `spare`.
   // The primal values the derivative part reads, broadcast to both lanes once before the loop:
   // read in the loop as a pair from memory, not loaded and unpacked once per pass.
-  std::unordered_map<NodeId, std::string> lane_names;
-  {
-    std::vector<char> primal(ctx.size(), 0), seen(ctx.size(), 0);
-    for (std::size_t i = 0; i < tangent.primal_assignments(); ++i) primal[tangent.assignments()[i].target] = 1;
-    std::vector<NodeId> stack;
-    auto walk = [&](NodeId root) {
-      stack.push_back(root);
-      while (!stack.empty()) {
-        const NodeId x = stack.back();
-        stack.pop_back();
-        if (seen[x]) continue;
-        seen[x] = 1;
-        const Op op = ctx.op(x);
-        if (op == Op::Select || op == Op::Sign || (op != Op::Add && op != Op::Mul && op != Op::Neg && op != Op::Div &&
-                                                  op != Op::Symbol && op != Op::Constant && !ctx.is_abbreviation(x)))
-          continue;  // conditions and function arguments keep plain names
-        std::string name;
-        if (ctx.is_abbreviation(x)) {
-          name = ctx.abbreviation_name(x);
-        } else if (op == Op::Symbol) {
-          const Symbol& sym = ctx.symbol(x);
-          if (sym.kind == SymbolKind::Aux && primal[x]) name = sym.name;
-          else if (sym.kind == SymbolKind::Input || sym.kind == SymbolKind::Parameter)
-            name = ctx.array(sym.array).name + "_" + std::to_string(sym.index);
-        }
-        if (!name.empty()) {
-          lane_names.emplace(x, "lane_" + name);
-          continue;
-        }
-        for (NodeId c : ctx.children(x)) stack.push_back(c);
-      }
-    };
-    for (std::size_t i = tangent.primal_assignments(); i < tangent.size(); ++i) walk(tangent.assignments()[i].value);
-    for (std::size_t j = primal_outputs; j < tangent.outputs().size(); ++j) walk(tangent.outputs()[j].value);
-    std::vector<std::pair<NodeId, std::string>> sorted(lane_names.begin(), lane_names.end());
-    std::sort(sorted.begin(), sorted.end());
-    for (const auto& [x, name] : sorted) {
-      body += "  const Lanes " + name + " = ";
-      printer.print(x, body);
-      body += ";\n";
-    }
+  const std::unordered_map<NodeId, std::string> lane_names = primal_values_read(tangent);
+  std::vector<std::pair<NodeId, std::string>> sorted(lane_names.begin(), lane_names.end());
+  std::sort(sorted.begin(), sorted.end());
+  for (const auto& [x, name] : sorted) {
+    body += "  const Lanes " + name + " = ";
+    printer.print(x, body);
+    body += ";\n";
   }
   const Printer lane_printer(ctx, &lane_names);
   std::size_t longest_seed = 1;
