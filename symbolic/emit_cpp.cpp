@@ -544,9 +544,6 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
     printer.print(o.value, body);
     body += ";  // " + one_line(o.name) + "\n";
   }
-  // Two directions per pass: the derivative part's arithmetic runs on pairs (Lanes, one SSE2
-  // register), so a direction costs about half the instructions; an odd last direction is paired
-  // with zero seeds and its partner's outputs go to `spare`.
   // The primal values the derivative part reads, broadcast to both lanes once before the loop:
   // read in the loop as a pair from memory, not loaded and unpacked once per pass.
   const std::unordered_map<NodeId, std::string> lane_names = primal_values_read(tangent);
@@ -558,6 +555,9 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
     body += ";\n";
   }
   const Printer lane_printer(ctx, &lane_names);
+  // Two directions per pass: the derivative part's arithmetic runs on pairs (Lanes, one SSE2
+  // register), so a direction costs about half the instructions; an odd last direction is paired
+  // with zero seeds and its partner's outputs go to `spare`.
   std::size_t longest_seed = 1;
   for (ArrayId a : seeded_arrays) longest_seed = std::max(longest_seed, ctx.array(ctx.seed_array(a)).elements.size());
   const std::string k = std::to_string(derivative_outputs);

@@ -49,10 +49,12 @@ ReducedDynamics::ReducedDynamics(const GeneratedModel& model) : model_(model), p
     b_cols_[a] = free_place_[a] >= 0 ? std::vector<int>{free_place_[a]} : block_u[block_of_v[-1 - free_place_[a]]];
   }
   for (std::size_t a = 0; a < f_.size(); ++a) {
-    if (free_place_[a] < 0) dependent_rows_.emplace_back(static_cast<int>(a), -1 - free_place_[a]);
-    if (free_place_[a] >= 0) independent_rows_.push_back({f_[a], free_place_[a]});
-    else
+    if (free_place_[a] >= 0) {
+      independent_rows_.push_back({f_[a], free_place_[a]});
+    } else {
+      dependent_rows_.emplace_back(static_cast<int>(a), -1 - free_place_[a]);
       for (int c : b_cols_[a]) dependent_entries_.push_back({f_[a], c, static_cast<int>(a) * nu + c});
+    }
   }
   s_start_.assign(1, 0);
   for (int j = 0; j < n; ++j) {

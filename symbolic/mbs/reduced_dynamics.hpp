@@ -100,7 +100,8 @@ class ReducedDynamics {
   std::vector<std::vector<int>> b_cols_;
   // The same by rows for the tangent's loops: an independent row's coordinate q and its column
   // (B's entry 1); a dependent row's entries, coordinate q, column c and the entry's place b in
-  // B (column-major); and the dependent rows' free row a with their place among v.
+  // B's row-major storage (a * nu + c); and the dependent rows' free row a with their place
+  // among v.
   struct IndependentRow {
     int q, place;
   };
