@@ -95,6 +95,7 @@ class Multibody : public Block {
       // mechanism is assembled in the same branch every run
       std::lock_guard<std::mutex> lock(mutex_);
       last_q_ = Eigen::Map<const Vector>(g_.initial_q, g_.n);
+      result_.dynamics_current = false;
       have_kinematics_ = have_dynamics_ = false;
     }
     const int nu = reduced_.nu();
@@ -263,7 +264,10 @@ class Multibody : public Block {
       ++kinematic_point_;
       try {
         try {
-          reduced_.solve_kinematics(e.x, e.x + nu, in.data(), p, last_q_, result_);
+          // from the last solution moved along its B: within O(|du|^2) of this one
+          if (result_.dynamics_current) reduced_.predict(result_, e.x, guess_);
+          else guess_ = last_q_;
+          reduced_.solve_kinematics(e.x, e.x + nu, in.data(), p, guess_, result_);
         } catch (const std::runtime_error&) {
           // the last solution may be far away (a new run of the same diagram): from the model's
           // initial configuration
@@ -383,7 +387,7 @@ class Multibody : public Block {
   bool exposed_;
   const double zero_[1] = {0.0};
   mutable std::mutex mutex_;
-  mutable Vector last_q_, kinematic_key_, dynamic_key_;
+  mutable Vector last_q_, guess_, kinematic_key_, dynamic_key_;
   mutable ReducedDynamics::Result result_;
   mutable bool have_kinematics_ = false, have_dynamics_ = false;
   mutable long point_ = 0;            ///< changes whenever result_ does

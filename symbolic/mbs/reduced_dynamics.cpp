@@ -80,6 +80,7 @@ void ReducedDynamics::solve_kinematics(const double* u, const double* ud, const 
   Result::Work& w = r.work;
   if (static_cast<int>(w.lam_zero.size()) != std::max(1, m)) w.lam_zero.assign(std::max(1, m), 0.0);  // never written
   r.q = guess;
+  r.dynamics_current = false;
   r.qd.setZero(n);
   r.qdd.setZero(n);
   for (int i = 0; i < nu; ++i) {
@@ -117,6 +118,18 @@ void ReducedDynamics::solve_kinematics(const double* u, const double* ud, const 
     w.fv.noalias() = r.J * r.qd;  // Jv vd = -J qd (vd still zero in qd)
     r.Jv.solve(w.fv.data(), m, 1, w.fv.data(), m);
     for (int i = 0; i < m; ++i) r.qd[v_[i]] = -w.fv[i];
+  }
+}
+
+void ReducedDynamics::predict(const Result& r, const double* u, Vector& guess) const {
+  guess = r.q;
+  if (!r.dynamics_current) return;
+  const int nu = this->nu();
+  for (const auto& [a, place] : dependent_rows_) {
+    const double* row = r.B.data() + static_cast<Eigen::Index>(a) * nu;
+    double dv = 0.0;
+    for (int c : b_cols_[a]) dv += row[c] * (u[c] - r.q[u_[c]]);
+    guess[v_[place]] += dv;
   }
 }
 
@@ -250,6 +263,7 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
     for (int i = 0; i < m; ++i) w.fv[i] = c[v_[i]] + r.MB(v_[i], nu) + r.MB.row(v_[i]).head(nu).dot(r.udd);
     r.Jv.transpose_solve(w.fv.data(), m, 1, r.lam.data(), m);
   }
+  r.dynamics_current = true;
 }
 
 void ReducedDynamics::seed_arrays(int nd, const double* dinputs, const double* dp_in, Matrix& dinp, Matrix& dp,

@@ -41,6 +41,7 @@ class ReducedDynamics {
     Matrix seeds;                                 // [B beta] over q
     RowMatrix MBf;                                // M_ff B
     int newton_iterations = 0;
+    bool dynamics_current = false;                // B (and the rest of the dynamic half) is at q
     // Scratch storage sized at the first call and reused, so that a solve and its tangents
     // allocate nothing once the sizes are known (the right-hand side's path).
     struct Work {
@@ -63,6 +64,10 @@ class ReducedDynamics {
   void solve_kinematics(const double* u, const double* ud, const double* inputs, const double* p,
                         const Vector& guess, Result& r) const;
   void solve_dynamics(const double* inputs, const double* p, Result& r) const;
+  // A start for the Newton iteration at new independent coordinates u: r's q with its dependent
+  // coordinates moved along B (dv = Bv du, the kinematics to first order), so the iteration
+  // starts O(|du|^2) from the solution. Without r's dynamics at its q, r's q as it is.
+  void predict(const Result& r, const double* u, Vector& guess) const;
 
   // Derivatives of q, qd, qdd (n x nd each, column per direction) for seeds on u, u_dot
   // (nu x nd), inputs (inputs x nd) and parameters (parameters x nd); null seeds are zero.
