@@ -111,29 +111,27 @@ class Multibody : public Block {
   }
 
   void outputs(const Eval& e, double* const* y) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
     const ReducedDynamics::Result& r = solve(e, needs_dynamics(e));
     const int n = g_.n;
     if (output_ready(e, 0)) std::copy_n(r.q.data(), n, y[0]);
     if (output_ready(e, 1)) std::copy_n(r.qd.data(), n, y[1]);
     if (output_ready(e, 2)) std::copy_n(r.qdd.data(), n, y[2]);
     if (g_.sensor_count == 0) return;
-    const Vector lam = padded(r.lam);
-    const Vector inp = inputs(e);
+    const double* lam = r.lam.size() ? r.lam.data() : zero_;  // (solve filled work_.in)
+    std::vector<double>& out = work_.out;
     for (int group = 0; group < 2; ++group) {
       if (!sensor_group_ready(e, group)) continue;
-      std::vector<double> out(std::max(1, group_outputs_[group]));
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        if (group == 0 && kinematic_sensor_values_.point == kinematic_point_ &&
-            kinematic_sensor_values_.values.size() == out.size()) {
-          out = kinematic_sensor_values_.values;
-        } else {
-          (group ? g_.sensors_acceleration : g_.sensors_kinematic)(r.q.data(), r.qd.data(), r.qdd.data(), lam.data(),
-                                                                    inp.data(), parameters(e), out.data());
-          if (group == 0) {
-            kinematic_sensor_values_.point = kinematic_point_;
-            kinematic_sensor_values_.values = out;
-          }
+      out.resize(std::max(1, group_outputs_[group]));
+      if (group == 0 && kinematic_sensor_values_.point == kinematic_point_ &&
+          kinematic_sensor_values_.values.size() == out.size()) {
+        out = kinematic_sensor_values_.values;
+      } else {
+        (group ? g_.sensors_acceleration : g_.sensors_kinematic)(r.q.data(), r.qd.data(), r.qdd.data(), lam,
+                                                                  work_.in.data(), parameters(e), out.data());
+        if (group == 0) {
+          kinematic_sensor_values_.point = kinematic_point_;
+          kinematic_sensor_values_.values = out;
         }
       }
       for (int s = 0; s < g_.sensor_count; ++s)
@@ -142,10 +140,11 @@ class Multibody : public Block {
   }
 
   void outputs_tangent(const Eval& e, const Seeds& s, const DirView* dy) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
     const bool dynamics = needs_dynamics(e);
     const ReducedDynamics::Result& r = solve(e, dynamics);
-    Matrix dq, dqd, dqdd, dinp, dp;
-    tangent(e, s, r, dynamics, dq, dqd, dqdd, dinp, dp);
+    const Matrix &dq = work_.dq, &dqd = work_.dqd, &dqdd = work_.dqdd, &dinp = work_.dinp, &dp = work_.dp;
+    tangent(e, s, r, dynamics);
     const int n = g_.n, nd = s.directions;
     const bool motion = output_ready(e, 0), acceleration = output_ready(e, 2);
     for (int d = 0; d < nd; ++d)
@@ -155,26 +154,24 @@ class Multibody : public Block {
         if (acceleration) dy[2](i, d) = dqdd(i, d);
       }
     if (g_.sensor_count == 0 || nd == 0) return;
-    const Vector lam = padded(r.lam);
-    const Vector inp = inputs(e);
+    const double* lam = r.lam.size() ? r.lam.data() : zero_;
+    std::vector<double>&out = work_.out, &dout = work_.dout;
     for (int group = 0; group < 2; ++group) {
       if (!sensor_group_ready(e, group)) continue;
       const int ns = group_outputs_[group];
-      std::vector<double> out(std::max(1, ns)), dout(static_cast<std::size_t>(std::max(1, ns)) * nd);
-      {
-        // the kinematic group depends on what the kinematic tangent does (q, qd, the driven
-        // joints' motion, p): kept with it, and reused while it is
-        std::lock_guard<std::mutex> lock(mutex_);
-        KeptSensors& kept = kinematic_sensor_tangent_;
-        if (group == 0 && kept.point == kinematic_point_ && same(kept.dq, dq) && same(kept.dqd, dqd) &&
-            same(kept.dp, dp) && kept.values.size() == dout.size()) {
-          dout = kept.values;
-        } else {
-          (group ? g_.sensors_acceleration_tangent : g_.sensors_kinematic_tangent)(
-              r.q.data(), r.qd.data(), r.qdd.data(), lam.data(), inp.data(), parameters(e), nd, dq.data(), dqd.data(),
-              dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
-          if (group == 0) kept.assign(kinematic_point_, dq, dqd, dp, dout);
-        }
+      out.resize(std::max(1, ns));
+      dout.resize(static_cast<std::size_t>(std::max(1, ns)) * nd);
+      // the kinematic group depends on what the kinematic tangent does (q, qd, the driven
+      // joints' motion, p): kept with it, and reused while it is
+      KeptSensors& kept = kinematic_sensor_tangent_;
+      if (group == 0 && kept.point == kinematic_point_ && same(kept.dq, dq) && same(kept.dqd, dqd) &&
+          same(kept.dp, dp) && kept.values.size() == dout.size()) {
+        dout = kept.values;
+      } else {
+        (group ? g_.sensors_acceleration_tangent : g_.sensors_kinematic_tangent)(
+            r.q.data(), r.qd.data(), r.qdd.data(), lam, work_.in.data(), parameters(e), nd, dq.data(), dqd.data(),
+            dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
+        if (group == 0) kept.assign(kinematic_point_, dq, dqd, dp, dout);
       }
       for (int k = 0; k < g_.sensor_count; ++k)
         if (sensor_group_[k] == group)
@@ -184,6 +181,7 @@ class Multibody : public Block {
   }
 
   void derivatives(const Eval& e, double* xdot) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
     const ReducedDynamics::Result& r = solve(e, true);
     const int nu = reduced_.nu();
     for (int i = 0; i < nu; ++i) {
@@ -193,9 +191,10 @@ class Multibody : public Block {
   }
 
   void derivatives_tangent(const Eval& e, const Seeds& s, DirView dxdot) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
     const ReducedDynamics::Result& r = solve(e, true);
-    Matrix dq, dqd, dqdd, dinp, dp;
-    tangent(e, s, r, true, dq, dqd, dqdd, dinp, dp);
+    tangent(e, s, r, true);
+    const Matrix& dqdd = work_.dqdd;
     const int nu = reduced_.nu();
     for (int d = 0; d < s.directions; ++d)
       for (int i = 0; i < nu; ++i) {
@@ -205,7 +204,6 @@ class Multibody : public Block {
   }
 
  private:
-  Vector padded(const Vector& v) const { return v.size() ? v : Vector::Zero(1); }
   static bool same(const Matrix& a, const Matrix& b) { return a.rows() == b.rows() && a.cols() == b.cols() && a == b; }
 
   // Whether this call sets the group's sensor ports (0: positions and velocities, 1: reads
@@ -221,8 +219,8 @@ class Multibody : public Block {
   // The model's input array: load components, then q, qd, qdd of each driven joint, from the
   // ports that are ready (the others zero: no output read in this call depends on them; a
   // driven joint not yet commanded sits at its assembly position).
-  Vector inputs(const Eval& e) const {
-    Vector in = Vector::Zero(std::max(1, g_.inputs));
+  void fill_inputs(const Eval& e, Vector& in) const {
+    in.setZero(std::max(1, g_.inputs));
     for (int k = 0; k < g_.loads; ++k)
       if (e.input_ready(k))
         for (int i = 0, at = load_offset(k); i < g_.load_widths[k]; ++i) in[at + i] = e.u[k][i];
@@ -231,7 +229,6 @@ class Multibody : public Block {
         const int port = g_.loads + 3 * i + j;
         in[g_.load_inputs + 3 * i + j] = e.input_ready(port) ? e.u[port][0] : (j == 0 ? g_.initial_q[g_.driven[i]] : 0.0);
       }
-    return in;
   }
   int load_offset(int k) const { return load_offsets_[k]; }
 
@@ -246,12 +243,14 @@ class Multibody : public Block {
   // arguments are unchanged: kinematics (x, the driven joints' q and qd, p), and with `dynamics`
   // the accelerations and multipliers (also the loads and driven accelerations). A value pass
   // asks for positions first and for accelerations once the loads are known: one solve each.
+  // Called with mutex_ held; fills work_.in.
   const ReducedDynamics::Result& solve(const Eval& e, bool dynamics) const {
     const int nu = reduced_.nu();
-    const Vector in = inputs(e);
+    Vector& in = work_.in;
+    fill_inputs(e, in);
     const double* p = parameters(e);
-    std::lock_guard<std::mutex> lock(mutex_);
-    Vector kinematic(2 * nu + 2 * g_.driven_count + g_.parameters);
+    Vector& kinematic = work_.kinematic;
+    kinematic.resize(2 * nu + 2 * g_.driven_count + g_.parameters);
     for (int i = 0; i < 2 * nu; ++i) kinematic[i] = e.x[i];
     for (int i = 0; i < g_.driven_count; ++i) {
       kinematic[2 * nu + 2 * i] = in[g_.load_inputs + 3 * i];
@@ -299,12 +298,16 @@ class Multibody : public Block {
   // Tangents of q, qd and, with `dynamics`, qdd. A tangent pass asks twice for the same full
   // tangent (the acceleration outputs, then the state derivatives): the last one is reused
   // for the same point and the same seeds.
-  void tangent(const Eval& e, const Seeds& s, const ReducedDynamics::Result& r, bool dynamics, Matrix& dq,
-               Matrix& dqd, Matrix& dqdd, Matrix& dinp, Matrix& dp) const {
+  // Called with mutex_ held, after solve(e, ...) (work_.in): sets work_'s seeds and dq, dqd,
+  // dqdd.
+  void tangent(const Eval& e, const Seeds& s, const ReducedDynamics::Result& r, bool dynamics) const {
     const int nu = reduced_.nu(), nd = s.directions;
-    Matrix du(nu, std::max(nd, 1)), dud(nu, std::max(nd, 1));
-    dinp = Matrix::Zero(std::max(1, g_.inputs), std::max(nd, 1));
-    dp = Matrix::Zero(std::max(1, g_.parameters), std::max(nd, 1));
+    Matrix &du = work_.du, &dud = work_.dud, &dinp = work_.dinp, &dp = work_.dp;
+    Matrix &dq = work_.dq, &dqd = work_.dqd, &dqdd = work_.dqdd;
+    du.resize(nu, std::max(nd, 1));
+    dud.resize(nu, std::max(nd, 1));
+    dinp.setZero(std::max(1, g_.inputs), std::max(nd, 1));
+    dp.setZero(std::max(1, g_.parameters), std::max(nd, 1));
     for (int d = 0; d < nd; ++d) {
       for (int i = 0; i < nu; ++i) {
         du(i, d) = s.x(i, d);
@@ -321,19 +324,15 @@ class Multibody : public Block {
       if (exposed_)
         for (int i = 0; i < g_.parameters; ++i) dp(i, d) = s.p(i, d);
     }
-    const Vector in = inputs(e);
-    const auto same = [](const Matrix& a, const Matrix& b) {
-      return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
-    };
-    std::lock_guard<std::mutex> lock(mutex_);
+    const Vector& in = work_.in;
     if (dynamics && full_tangent_.point == point_ && same(full_tangent_.du, du) && same(full_tangent_.dud, dud) &&
         same(full_tangent_.dinp, dinp) && same(full_tangent_.dp, dp)) {
       dq = full_tangent_.dq, dqd = full_tangent_.dqd, dqdd = full_tangent_.dqdd;
       return;
     }
     // Positions and velocities read the driven joints' q and qd seeds, not the loads'.
-    Matrix driven(std::max(1, 2 * g_.driven_count), std::max(nd, 1));
-    driven.setZero();
+    Matrix& driven = work_.driven;
+    driven.setZero(std::max(1, 2 * g_.driven_count), std::max(nd, 1));
     for (int i = 0; i < g_.driven_count; ++i)
       for (int j = 0; j < 2; ++j) driven.row(2 * i + j) = dinp.row(g_.load_inputs + 3 * i + j);
     if (kinematic_tangent_.point == kinematic_point_ && same(kinematic_tangent_.du, du) &&
@@ -346,7 +345,7 @@ class Multibody : public Block {
       kinematic_tangent_.assign(kinematic_point_, du, dud, driven, dp, dq, dqd, nullptr);
     }
     if (!dynamics) {
-      dqdd = Matrix::Zero(g_.n, std::max(nd, 1));  // not read: no acceleration output in this call
+      dqdd.setZero(g_.n, std::max(nd, 1));  // not read: no acceleration output in this call
       return;
     }
     reduced_.tangent_dynamics(r, in.data(), parameters(e), nd, dinp.data(), dp.data(), dq, dqd, dqdd);
@@ -394,6 +393,14 @@ class Multibody : public Block {
   mutable long kinematic_point_ = 0;  ///< changes whenever result_'s kinematics do
   mutable KeptTangent kinematic_tangent_, full_tangent_;
   mutable KeptSensors kinematic_sensor_values_, kinematic_sensor_tangent_;
+  /// Storage of one call (under mutex_), sized at the first and reused: the right-hand side's
+  /// path allocates nothing once the sizes are known.
+  struct Work {
+    Vector in, kinematic;
+    Matrix du, dud, dinp, dp, driven, dq, dqd, dqdd;
+    std::vector<double> out, dout;
+  };
+  mutable Work work_;
 };
 
 std::vector<engine::ParamSpec> exposed_parameters(const GeneratedModel& g) {
