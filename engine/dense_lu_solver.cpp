@@ -1,6 +1,7 @@
 #include "engine/dense_lu_solver.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <nvector/nvector_serial.h>
 #include <sunmatrix/sunmatrix_dense.h>
@@ -11,6 +12,7 @@ namespace {
 struct Content {
   Eigen::PartialPivLU<Eigen::MatrixXd> lu;
   Eigen::MatrixXd work;
+  Eigen::VectorXd rhs;  ///< the permuted right-hand side, substituted in place
   sunindextype last_flag = 0;
 };
 
@@ -41,12 +43,32 @@ int setup(SUNLinearSolver S, SUNMatrix A) {
   return SUNLS_SUCCESS;
 }
 
+// x = U^-1 L^-1 P b by column-oriented substitutions: each step is one contiguous multiply-add
+// over a column of the factors. Eigen's own solve splits the small
+// triangles into panels and matrix-vector products, at about five instructions per
+// multiply-add on 56 states, a fifteenth of the main job.
 int solve(SUNLinearSolver S, SUNMatrix A, N_Vector x, N_Vector b, realtype) {
   Content& c = content(S);
   const auto n = static_cast<Eigen::Index>(SM_ROWS_D(A));
-  Eigen::Map<Eigen::VectorXd> xv(NV_DATA_S(x), n);
-  const Eigen::Map<const Eigen::VectorXd> bv(NV_DATA_S(b), n);
-  xv = c.lu.solve(bv);
+  const double* __restrict lu = c.lu.matrixLU().data();
+  const auto& to = c.lu.permutationP().indices();  // (P b)[to[i]] = b[i]
+  double* __restrict z = c.rhs.data();
+  const double* bv = NV_DATA_S(b);
+  for (Eigen::Index i = 0; i < n; ++i) z[to[i]] = bv[i];
+  for (Eigen::Index j = 0; j < n; ++j) {  // L (unit diagonal)
+    const double zj = z[j];
+    if (zj == 0.0) continue;
+    const double* __restrict below = lu + j * n + j + 1;
+    double* __restrict rest = z + j + 1;
+    for (Eigen::Index i = 0; i < n - j - 1; ++i) rest[i] -= below[i] * zj;
+  }
+  for (Eigen::Index j = n - 1; j >= 0; --j) {  // U
+    const double* __restrict column = lu + j * n;
+    const double zj = z[j] /= column[j];
+    if (zj == 0.0) continue;
+    for (Eigen::Index i = 0; i < j; ++i) z[i] -= column[i] * zj;
+  }
+  std::copy_n(z, n, NV_DATA_S(x));
   c.last_flag = 0;
   return SUNLS_SUCCESS;
 }
@@ -83,6 +105,7 @@ SUNLinearSolver make_dense_lu_solver(SUNContext context, int n) {
   S->ops->free = release;
   auto* c = new Content;
   c->work.resize(n, n);
+  c->rhs.resize(n);
   c->lu = Eigen::PartialPivLU<Eigen::MatrixXd>(n);
   S->content = c;
   return S;

@@ -1,7 +1,8 @@
 // The Newton iteration's linear solver for CVODES: the dense matrix SUNDIALS forms (I - gamma J)
 // factored by Eigen's partial-pivoting LU (blocked and vectorised) instead of SUNDIALS' own
 // column-by-column GETRF/GETRS, which on the sedan's 52 states took about a seventh of the
-// main job. A SUNDIALS linear solver of the direct type on a dense SUNMatrix, so CVODES uses it
+// main job; solved by plain column-oriented substitutions (Eigen's panelled triangular solves
+// are slow at this size). A SUNDIALS linear solver of the direct type on a dense SUNMatrix, so CVODES uses it
 // like SUNLinSol_Dense.
 #pragma once
 

@@ -1,7 +1,7 @@
 // The CVODES Newton solver (engine/dense_lu_solver): solves a dense system as Eigen's
 // full-pivoting LU does (an independent factorisation), needs no pivoting-free matrix, and
 // reports a singular matrix as SUNDIALS' dense solver does (a recoverable factorisation
-// failure naming the column), so CVODES retries with a smaller step.
+// failure naming the column), so CVODES retries with a smaller step. Solves in place too.
 #include "engine/dense_lu_solver.hpp"
 
 #include <gtest/gtest.h>
@@ -45,6 +45,16 @@ TEST(DenseLuSolver, SolvesLikeAnIndependentFactorisation) {
   const Eigen::Map<const Eigen::VectorXd> got(NV_DATA_S(x), n);
   EXPECT_LT((got - expected).cwiseAbs().maxCoeff(), 1e-11 * expected.cwiseAbs().maxCoeff());
   EXPECT_LT((A * got - b).cwiseAbs().maxCoeff(), 1e-12);
+
+  // in place (x is b), for a right-hand side whose first entries are zero (substitution skips
+  // zero entries)
+  Eigen::VectorXd b2 = b;
+  b2.head(10).setZero();
+  Eigen::Map<Eigen::VectorXd>(NV_DATA_S(rhs), n) = b2;
+  ASSERT_EQ(SUNLinSolSolve(S, M, rhs, rhs, 0.0), SUNLS_SUCCESS);
+  const Eigen::VectorXd expected2 = A.fullPivLu().solve(b2);
+  const Eigen::Map<const Eigen::VectorXd> got2(NV_DATA_S(rhs), n);
+  EXPECT_LT((got2 - expected2).cwiseAbs().maxCoeff(), 1e-11 * expected2.cwiseAbs().maxCoeff());
 
   // a zero column: singular, reported at that column (1-based)
   Eigen::Map<Eigen::MatrixXd>(SM_DATA_D(M), n, n).col(7).setZero();
