@@ -15,6 +15,7 @@
 // (so scenes can make them sensitivity directions).
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <mutex>
 
 #include "engine/registry.hpp"
@@ -168,9 +169,26 @@ class Multibody : public Block {
           same(kept.dp, dp) && kept.values.size() == dout.size()) {
         dout = kept.values;
       } else {
-        (group ? g_.sensors_acceleration_tangent : g_.sensors_kinematic_tangent)(
-            r.q.data(), r.qd.data(), r.qdd.data(), lam, work_.in.data(), parameters(e), nd, dq.data(), dqd.data(),
-            dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
+        const auto sensors = group ? g_.sensors_acceleration_tangent : g_.sensors_kinematic_tangent;
+        Work& w = work_;
+        if (group == 0) live_columns({&dq, &dqd, &dinp, &dp}, nd, w.live);
+        else live_columns({&dq, &dqd, &dqdd, &dinp, &dp}, nd, w.live);
+        const int nl = static_cast<int>(w.live.size());
+        if (nl == nd) {
+          sensors(r.q.data(), r.qd.data(), r.qdd.data(), lam, w.in.data(), parameters(e), nd, dq.data(), dqd.data(),
+                  dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
+        } else {  // the directions with nonzero seeds only, as in tangent()
+          gather(dq, w.live, w.c_dq), gather(dqd, w.live, w.c_dqd), gather(dqdd, w.live, w.c_dqdd);
+          gather(dinp, w.live, w.c_dinp), gather(dp, w.live, w.c_dp);
+          w.c_dout.resize(static_cast<std::size_t>(std::max(1, ns)) * std::max(1, nl));
+          if (nl > 0)
+            sensors(r.q.data(), r.qd.data(), r.qdd.data(), lam, w.in.data(), parameters(e), nl, w.c_dq.data(),
+                    w.c_dqd.data(), w.c_dqdd.data(), w.c_dinp.data(), w.c_dp.data(), out.data(), w.c_dout.data());
+          std::fill(dout.begin(), dout.end(), 0.0);
+          for (int c = 0; c < nl; ++c)
+            std::copy_n(w.c_dout.data() + static_cast<std::size_t>(c) * ns, ns,
+                        dout.data() + static_cast<std::size_t>(w.live[c]) * ns);
+        }
         if (group == 0) kept.assign(kinematic_point_, dq, dqd, dp, dout);
       }
       for (int k = 0; k < g_.sensor_count; ++k)
@@ -205,6 +223,27 @@ class Multibody : public Block {
 
  private:
   static bool same(const Matrix& a, const Matrix& b) { return a.rows() == b.rows() && a.cols() == b.cols() && a == b; }
+  // The directions (columns below nd) in which any of the matrices has a nonzero entry.
+  static void live_columns(std::initializer_list<const Matrix*> matrices, int nd, std::vector<int>& live) {
+    live.clear();
+    for (int d = 0; d < nd; ++d)
+      for (const Matrix* m : matrices)
+        if (!m->col(d).isZero(0.0)) {
+          live.push_back(d);
+          break;
+        }
+  }
+  // Columns `live` of a, side by side (one zero column when there are none).
+  static void gather(const Matrix& a, const std::vector<int>& live, Matrix& b) {
+    b.resize(a.rows(), std::max<Eigen::Index>(1, live.size()));
+    if (live.empty()) b.setZero();
+    for (std::size_t c = 0; c < live.size(); ++c) b.col(c) = a.col(live[c]);
+  }
+  // The inverse: an rows x nd matrix with b's columns at `live` and zeros elsewhere.
+  static void scatter(const Matrix& b, const std::vector<int>& live, int rows, int nd, Matrix& a) {
+    a.setZero(rows, std::max(nd, 1));
+    for (std::size_t c = 0; c < live.size(); ++c) a.col(live[c]) = b.col(c);
+  }
 
   // Whether this call sets the group's sensor ports (0: positions and velocities, 1: reads
   // qdd): the ports of a group read the same inputs, so one port answers for all.
@@ -340,15 +379,42 @@ class Multibody : public Block {
         same(kinematic_tangent_.dp, dp)) {
       dq = kinematic_tangent_.dq, dqd = kinematic_tangent_.dqd;
     } else {
-      reduced_.tangent_kinematics(r, in.data(), parameters(e), nd, du.data(), dud.data(), dinp.data(), dp.data(), dq,
-                                  dqd);
+      // Directions whose seeds are all zero (in a Jacobian pass, the states of blocks that do not
+      // reach the car) have zero tangents: the partitioning and the generated tangents run on
+      // the others only.
+      Work& w = work_;
+      live_columns({&du, &dud, &driven, &dp}, nd, w.live);
+      const int nl = static_cast<int>(w.live.size());
+      if (nl == nd) {
+        reduced_.tangent_kinematics(r, in.data(), parameters(e), nd, du.data(), dud.data(), dinp.data(), dp.data(),
+                                    dq, dqd);
+      } else {
+        gather(du, w.live, w.c_du), gather(dud, w.live, w.c_dud), gather(dinp, w.live, w.c_dinp);
+        gather(dp, w.live, w.c_dp);
+        if (nl > 0)
+          reduced_.tangent_kinematics(r, in.data(), parameters(e), nl, w.c_du.data(), w.c_dud.data(), w.c_dinp.data(),
+                                      w.c_dp.data(), w.c_dq, w.c_dqd);
+        scatter(w.c_dq, w.live, g_.n, nd, dq), scatter(w.c_dqd, w.live, g_.n, nd, dqd);
+      }
       kinematic_tangent_.assign(kinematic_point_, du, dud, driven, dp, dq, dqd, nullptr);
     }
     if (!dynamics) {
       dqdd.setZero(g_.n, std::max(nd, 1));  // not read: no acceleration output in this call
       return;
     }
-    reduced_.tangent_dynamics(r, in.data(), parameters(e), nd, dinp.data(), dp.data(), dq, dqd, dqdd);
+    Work& w = work_;
+    live_columns({&du, &dud, &dinp, &dp}, nd, w.live);
+    const int nl = static_cast<int>(w.live.size());
+    if (nl == nd) {
+      reduced_.tangent_dynamics(r, in.data(), parameters(e), nd, dinp.data(), dp.data(), dq, dqd, dqdd);
+    } else {
+      gather(dinp, w.live, w.c_dinp), gather(dp, w.live, w.c_dp), gather(dq, w.live, w.c_dq);
+      gather(dqd, w.live, w.c_dqd);
+      if (nl > 0)
+        reduced_.tangent_dynamics(r, in.data(), parameters(e), nl, w.c_dinp.data(), w.c_dp.data(), w.c_dq, w.c_dqd,
+                                  w.c_dqdd);
+      scatter(w.c_dqdd, w.live, g_.n, nd, dqdd);
+    }
     full_tangent_.assign(point_, du, dud, dinp, dp, dq, dqd, &dqdd);
   }
 
@@ -399,6 +465,10 @@ class Multibody : public Block {
     Vector in, kinematic;
     Matrix du, dud, dinp, dp, driven, dq, dqd, dqdd;
     std::vector<double> out, dout;
+    // the directions with nonzero seeds, and the seeds and tangents in those directions only
+    std::vector<int> live;
+    Matrix c_du, c_dud, c_dinp, c_dp, c_dq, c_dqd, c_dqdd;
+    std::vector<double> c_dout;
   };
   mutable Work work_;
 };
