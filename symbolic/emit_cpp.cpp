@@ -587,18 +587,20 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
 EmittedFunction emit_trig_table(std::size_t size, const EmitOptions& options) {
   const std::string n = std::to_string(size), x = options.trig_array;
   const std::string signature = linkage(options) + "const double* " + options.trig_table + "(const double* " + x + ") noexcept";
-  std::string body = "// sin and cos of every " + x + "[i] at table[2*i] and table[2*i + 1], computed again only when " +
-                     x + "\n// differs from the previous call's on this thread\n" + signature + "\n{\n";
+  std::string body = "// sin and cos of every " + x + "[i] at table[2*i] and table[2*i + 1], on this thread computed\n" +
+                     "// again only for the entries that differ from the previous call's (a Newton iteration on the\n" +
+                     "// constraints moves the dependent coordinates only)\n" + signature + "\n{\n";
   body += "  thread_local double last[" + n + "];\n";
   body += "  thread_local double table[2*" + n + "];\n";
   body += "  thread_local bool filled = false;\n";
   body += "  if (filled && std::memcmp(last, " + x + ", sizeof last) == 0) return table;\n";
   body += "  for (int i = 0; i < " + n + "; ++i) {\n";
   body += "    const double v = " + x + "[i];  // read once: the compiler pairs sin and cos into one sincos\n";
+  body += "    if (filled && std::memcmp(&v, &last[i], sizeof v) == 0) continue;\n";
   body += "    table[2*i] = std::sin(v);\n";
   body += "    table[2*i + 1] = std::cos(v);\n";
+  body += "    last[i] = v;\n";
   body += "  }\n";
-  body += "  std::memcpy(last, " + x + ", sizeof last);\n";
   body += "  filled = true;\n";
   body += "  return table;\n}\n";
   return EmittedFunction{options.trig_table, signature + ";\n", body};

@@ -53,15 +53,20 @@ void BlockLU::set_pattern(const Eigen::Matrix<char, Eigen::Dynamic, Eigen::Dynam
   }
 }
 
-bool BlockLU::factor(Block& b) {
-  const int k = static_cast<int>(b.rows.size());
-  double* a = b.lu.data();
+namespace {
+
+// Doolittle's elimination with partial pivoting of a k x k column-major block in place, and the
+// substitution through its factors. K > 0 fixes k at compile time (the loops unroll: a corner's
+// blocks have four to six columns); K = 0 reads it at run time.
+template <int K>
+bool factor_block(double* a, int* pivot, int k_run) {
+  const int k = K > 0 ? K : k_run;
   bool regular = true;
   for (int j = 0; j < k; ++j) {
     int p = j;
     for (int i = j + 1; i < k; ++i)
       if (std::abs(a[j * k + i]) > std::abs(a[j * k + p])) p = i;
-    b.pivot[j] = p;
+    pivot[j] = p;
     if (p != j)
       for (int c = 0; c < k; ++c) std::swap(a[c * k + j], a[c * k + p]);
     const double d = a[j * k + j];
@@ -79,15 +84,47 @@ bool BlockLU::factor(Block& b) {
   return regular;
 }
 
-void BlockLU::apply_factors(const Block& b, double* z) {
-  const int k = static_cast<int>(b.rows.size());
-  const double* __restrict a = b.lu.data();
-  for (int j = 0; j < k; ++j) std::swap(z[j], z[b.pivot[j]]);  // P b
-  for (int j = 0; j < k; ++j)                                   // L y = P b
+template <int K>
+void substitute_block(const double* __restrict a, const int* pivot, double* __restrict z, int k_run) {
+  const int k = K > 0 ? K : k_run;
+  for (int j = 0; j < k; ++j) std::swap(z[j], z[pivot[j]]);  // P b
+  for (int j = 0; j < k; ++j)                                 // L y = P b
     for (int i = j + 1; i < k; ++i) z[i] -= a[j * k + i] * z[j];
-  for (int j = k - 1; j >= 0; --j) {                            // U x = y
+  for (int j = k - 1; j >= 0; --j) {                          // U x = y
     z[j] /= a[j * k + j];
     for (int i = 0; i < j; ++i) z[i] -= a[j * k + i] * z[j];
+  }
+}
+
+}  // namespace
+
+bool BlockLU::factor(Block& b) {
+  const int k = static_cast<int>(b.rows.size());
+  double* a = b.lu.data();
+  int* pivot = b.pivot.data();
+  switch (k) {
+    case 1: return factor_block<1>(a, pivot, k);
+    case 2: return factor_block<2>(a, pivot, k);
+    case 3: return factor_block<3>(a, pivot, k);
+    case 4: return factor_block<4>(a, pivot, k);
+    case 5: return factor_block<5>(a, pivot, k);
+    case 6: return factor_block<6>(a, pivot, k);
+    default: return factor_block<0>(a, pivot, k);
+  }
+}
+
+void BlockLU::apply_factors(const Block& b, double* z) {
+  const int k = static_cast<int>(b.rows.size());
+  const double* a = b.lu.data();
+  const int* pivot = b.pivot.data();
+  switch (k) {
+    case 1: return substitute_block<1>(a, pivot, z, k);
+    case 2: return substitute_block<2>(a, pivot, z, k);
+    case 3: return substitute_block<3>(a, pivot, z, k);
+    case 4: return substitute_block<4>(a, pivot, z, k);
+    case 5: return substitute_block<5>(a, pivot, z, k);
+    case 6: return substitute_block<6>(a, pivot, z, k);
+    default: return substitute_block<0>(a, pivot, z, k);
   }
 }
 
