@@ -596,7 +596,7 @@ EmittedFunction emit_trig_table(std::size_t size, const EmitOptions& options) {
   body += "  if (filled && std::memcmp(last, " + x + ", sizeof last) == 0) return table;\n";
   body += "  for (int i = 0; i < " + n + "; ++i) {\n";
   body += "    const double v = " + x + "[i];  // read once: the compiler pairs sin and cos into one sincos\n";
-  body += "    if (filled && std::memcmp(&v, &last[i], sizeof v) == 0) continue;\n";
+  body += "    if (filled && v == last[i] && std::signbit(v) == std::signbit(last[i])) continue;  // the same bits\n";
   body += "    table[2*i] = std::sin(v);\n";
   body += "    table[2*i + 1] = std::cos(v);\n";
   body += "    last[i] = v;\n";
