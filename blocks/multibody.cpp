@@ -69,8 +69,7 @@ class Multibody : public Block {
       if (!g_.sensor_reads_acceleration[s]) set_output_reads(3 + s, driven_motion);
       const int group = g_.sensor_reads_acceleration[s] ? 1 : 0;
       if (group_port_[group] < 0) group_port_[group] = s;
-      sensor_group_.push_back(group);
-      sensor_offset_.push_back(group_size[group]);
+      group_ports_[group].push_back({3 + s, group_size[group], g_.sensor_widths[s]});
       group_size[group] += g_.sensor_widths[s];
     }
     group_outputs_[0] = group_size[0];
@@ -135,8 +134,7 @@ class Multibody : public Block {
           kinematic_sensor_values_.values = out;
         }
       }
-      for (int s = 0; s < g_.sensor_count; ++s)
-        if (sensor_group_[s] == group) std::copy_n(out.data() + sensor_offset_[s], g_.sensor_widths[s], y[3 + s]);
+      for (const GroupPort& port : group_ports_[group]) std::copy_n(out.data() + port.offset, port.width, y[port.output]);
     }
   }
 
@@ -191,10 +189,11 @@ class Multibody : public Block {
         }
         if (group == 0) kept.assign(kinematic_point_, dq, dqd, dp, dout);
       }
-      for (int k = 0; k < g_.sensor_count; ++k)
-        if (sensor_group_[k] == group)
-          for (int d = 0; d < nd; ++d)
-            for (int i = 0; i < g_.sensor_widths[k]; ++i) dy[3 + k](i, d) = dout[d * ns + sensor_offset_[k] + i];
+      for (int d = 0; d < nd; ++d) {
+        const double* from = dout.data() + static_cast<std::size_t>(d) * ns;
+        for (const GroupPort& port : group_ports_[group])
+          std::copy_n(from + port.offset, port.width, &dy[port.output](0, d));
+      }
     }
   }
 
@@ -444,8 +443,12 @@ class Multibody : public Block {
 
   const GeneratedModel& g_;
   std::vector<int> load_offsets_;  ///< each load's first entry in the model's input array
-  /// Each sensor port's group (1: reads qdd) and first entry among its group's outputs.
-  std::vector<int> sensor_group_, sensor_offset_;
+  /// The sensor ports by group (1: they read qdd): each port's output index, its first entry
+  /// among the group's outputs, its width.
+  struct GroupPort {
+    int output, offset, width;
+  };
+  std::vector<GroupPort> group_ports_[2];
   int group_outputs_[2] = {0, 0};
   int group_port_[2] = {-1, -1};  ///< a sensor port of each group (-1: none)
   ReducedDynamics reduced_;
