@@ -323,6 +323,28 @@ struct LaneSeed {
   b[j] = x.second();
 }
 
+// One direction (an odd last one): the same derivative code on plain doubles. A primal value
+// broadcast to Lanes enters by its first lane (no instruction: the register's low half).
+struct One {
+  double v;
+  One(double x) : v(x) {}            // NOLINT(google-explicit-constructor): constants
+  One(Lanes x) : v(x.first()) {}     // NOLINT(google-explicit-constructor): primal values
+};
+[[maybe_unused]] inline One operator+(One x, One y) { return One(x.v + y.v); }
+[[maybe_unused]] inline One operator-(One x, One y) { return One(x.v - y.v); }
+[[maybe_unused]] inline One operator*(One x, One y) { return One(x.v * y.v); }
+[[maybe_unused]] inline One operator/(One x, One y) { return One(x.v / y.v); }
+[[maybe_unused]] inline One operator-(One x) { return One(-x.v); }
+
+struct OneSeed {
+  const double* a;
+  One operator[](int i) const { return One(a[i]); }
+};
+
+// (dout_b is a null constant there: the overload is chosen by its type, so that a constant 0.0
+// stores as One)
+[[maybe_unused]] inline void store_lanes(double* a, decltype(nullptr), int j, One x) { a[j] = x.v; }
+
 }  // namespace
 
 )";
@@ -556,30 +578,38 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
   }
   const Printer lane_printer(ctx, &lane_names);
   // Two directions per pass: the derivative part's arithmetic runs on pairs (Lanes, one SSE2
-  // register), so a direction costs about half the instructions; an odd last direction is paired
-  // with zero seeds and its partner's outputs go to `spare`.
-  std::size_t longest_seed = 1;
-  for (ArrayId a : seeded_arrays) longest_seed = std::max(longest_seed, ctx.array(ctx.seed_array(a)).elements.size());
+  // register), so a direction costs about half the instructions. An odd last direction runs the
+  // same code once more on plain doubles (One, OneSeed): a sensitivity pass has one direction.
   const std::string k = std::to_string(derivative_outputs);
-  body += "  static const double zero_seed[" + std::to_string(longest_seed) + "] = {};\n";
-  body += "  [[maybe_unused]] double spare[" + std::to_string(std::max<std::size_t>(1, derivative_outputs)) + "];\n";
-  body += "  for (int d = 0; d < nd; d += 2) {\n";
-  body += "    const bool pair = d + 1 < nd;\n";
+  std::string derivatives;  // the loop's body, for either lane type
+  write_assignments(tangent, lane_printer, tangent.primal_assignments(), tangent.size(), "    ", derivatives, "auto");
+  for (std::size_t j = 0; j < derivative_outputs; ++j) {
+    const Output& o = tangent.outputs()[primal_outputs + j];
+    derivatives += "    store_lanes(dout_a, dout_b, " + std::to_string(j) + ", ";
+    lane_printer.print(o.value, derivatives);
+    derivatives += ");  // " + one_line(o.name) + "\n";
+  }
+  body += "  for (int d = 0; d + 1 < nd; d += 2) {\n";
   for (ArrayId a : seeded_arrays) {
     const Array& seed = ctx.array(ctx.seed_array(a));
     const std::string size = std::to_string(seed.elements.size()), from = "seed_" + ctx.array(a).name;
-    body += "    [[maybe_unused]] const LaneSeed " + seed.name + "{" + from + " + d*" + size + ", pair ? " + from +
-            " + (d + 1)*" + size + " : zero_seed};\n";
+    body += "    [[maybe_unused]] const LaneSeed " + seed.name + "{" + from + " + d*" + size + ", " + from +
+            " + (d + 1)*" + size + "};\n";
   }
   body += "    double* const dout_a = dout + d*" + k + ";\n";
-  body += "    [[maybe_unused]] double* const dout_b = pair ? dout_a + " + k + " : spare;\n";
-  write_assignments(tangent, lane_printer, tangent.primal_assignments(), tangent.size(), "    ", body, "auto");
-  for (std::size_t j = 0; j < derivative_outputs; ++j) {
-    const Output& o = tangent.outputs()[primal_outputs + j];
-    body += "    store_lanes(dout_a, dout_b, " + std::to_string(j) + ", ";
-    lane_printer.print(o.value, body);
-    body += ");  // " + one_line(o.name) + "\n";
+  body += "    [[maybe_unused]] double* const dout_b = dout_a + " + k + ";\n";
+  body += derivatives;
+  body += "  }\n";
+  body += "  if (nd % 2 == 1) {\n";
+  body += "    const int d = nd - 1;\n";
+  for (ArrayId a : seeded_arrays) {
+    const Array& seed = ctx.array(ctx.seed_array(a));
+    const std::string size = std::to_string(seed.elements.size()), from = "seed_" + ctx.array(a).name;
+    body += "    [[maybe_unused]] const OneSeed " + seed.name + "{" + from + " + d*" + size + "};\n";
   }
+  body += "    double* const dout_a = dout + d*" + k + ";\n";
+  body += "    [[maybe_unused]] constexpr decltype(nullptr) dout_b = nullptr;\n";
+  body += derivatives;
   body += "  }\n}\n";
   return EmittedFunction{options.function_name, wrapped_signature(signature) + ";\n", body, true};
 }
