@@ -44,9 +44,9 @@ int setup(SUNLinearSolver S, SUNMatrix A) {
 }
 
 // x = U^-1 L^-1 P b by column-oriented substitutions: each step is one contiguous multiply-add
-// over a column of the factors. Eigen's own solve splits the small
-// triangles into panels and matrix-vector products, at about five instructions per
-// multiply-add on 56 states, a fifteenth of the main job.
+// over a column of the factors. Eigen's own solve splits the small triangles into panels and
+// matrix-vector products, at about five instructions per multiply-add on 54 unknowns (a
+// fifteenth of the main job).
 int solve(SUNLinearSolver S, SUNMatrix A, N_Vector x, N_Vector b, realtype) {
   Content& c = content(S);
   const auto n = static_cast<Eigen::Index>(SM_ROWS_D(A));

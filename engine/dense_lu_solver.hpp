@@ -2,8 +2,8 @@
 // factored by Eigen's partial-pivoting LU (blocked and vectorised) instead of SUNDIALS' own
 // column-by-column GETRF/GETRS, which on the sedan's 52 states took about a seventh of the
 // main job; solved by plain column-oriented substitutions (Eigen's panelled triangular solves
-// are slow at this size). A SUNDIALS linear solver of the direct type on a dense SUNMatrix, so CVODES uses it
-// like SUNLinSol_Dense.
+// are slow at this size). A SUNDIALS linear solver of the direct type on a dense SUNMatrix, so
+// CVODES uses it like SUNLinSol_Dense.
 #pragma once
 
 #include <sundials/sundials_context.h>

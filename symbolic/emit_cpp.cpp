@@ -589,24 +589,26 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
     lane_printer.print(o.value, derivatives);
     derivatives += ");  // " + one_line(o.name) + "\n";
   }
+  // each seed array as the pass reads it: `dq{seed_q + d*33, seed_q + (d + 1)*33}` for a pair,
+  // `dq{seed_q + d*33}` for one direction
+  auto declare_seeds = [&](const std::string& type, bool pair) {
+    for (ArrayId a : seeded_arrays) {
+      const Array& seed = ctx.array(ctx.seed_array(a));
+      const std::string size = std::to_string(seed.elements.size()), from = "seed_" + ctx.array(a).name;
+      body += "    [[maybe_unused]] const " + type + " " + seed.name + "{" + from + " + d*" + size;
+      if (pair) body += ", " + from + " + (d + 1)*" + size;
+      body += "};\n";
+    }
+  };
   body += "  for (int d = 0; d + 1 < nd; d += 2) {\n";
-  for (ArrayId a : seeded_arrays) {
-    const Array& seed = ctx.array(ctx.seed_array(a));
-    const std::string size = std::to_string(seed.elements.size()), from = "seed_" + ctx.array(a).name;
-    body += "    [[maybe_unused]] const LaneSeed " + seed.name + "{" + from + " + d*" + size + ", " + from +
-            " + (d + 1)*" + size + "};\n";
-  }
+  declare_seeds("LaneSeed", true);
   body += "    double* const dout_a = dout + d*" + k + ";\n";
   body += "    [[maybe_unused]] double* const dout_b = dout_a + " + k + ";\n";
   body += derivatives;
   body += "  }\n";
   body += "  if (nd % 2 == 1) {\n";
   body += "    const int d = nd - 1;\n";
-  for (ArrayId a : seeded_arrays) {
-    const Array& seed = ctx.array(ctx.seed_array(a));
-    const std::string size = std::to_string(seed.elements.size()), from = "seed_" + ctx.array(a).name;
-    body += "    [[maybe_unused]] const OneSeed " + seed.name + "{" + from + " + d*" + size + "};\n";
-  }
+  declare_seeds("OneSeed", false);
   body += "    double* const dout_a = dout + d*" + k + ";\n";
   body += "    [[maybe_unused]] constexpr decltype(nullptr) dout_b = nullptr;\n";
   body += derivatives;

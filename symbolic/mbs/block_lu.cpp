@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
+#include <type_traits>
 #include <utility>
 
 namespace dydp::mbs {
@@ -96,36 +97,31 @@ void substitute_block(const double* __restrict a, const int* pivot, double* __re
   }
 }
 
+// f(std::integral_constant<int, K>) with K = k for k of one to six, K = 0 (size read at run
+// time) above
+template <typename F>
+decltype(auto) with_block_size(int k, F f) {
+  switch (k) {
+    case 1: return f(std::integral_constant<int, 1>{});
+    case 2: return f(std::integral_constant<int, 2>{});
+    case 3: return f(std::integral_constant<int, 3>{});
+    case 4: return f(std::integral_constant<int, 4>{});
+    case 5: return f(std::integral_constant<int, 5>{});
+    case 6: return f(std::integral_constant<int, 6>{});
+    default: return f(std::integral_constant<int, 0>{});
+  }
+}
+
 }  // namespace
 
 bool BlockLU::factor(Block& b) {
   const int k = static_cast<int>(b.rows.size());
-  double* a = b.lu.data();
-  int* pivot = b.pivot.data();
-  switch (k) {
-    case 1: return factor_block<1>(a, pivot, k);
-    case 2: return factor_block<2>(a, pivot, k);
-    case 3: return factor_block<3>(a, pivot, k);
-    case 4: return factor_block<4>(a, pivot, k);
-    case 5: return factor_block<5>(a, pivot, k);
-    case 6: return factor_block<6>(a, pivot, k);
-    default: return factor_block<0>(a, pivot, k);
-  }
+  return with_block_size(k, [&](auto K) { return factor_block<decltype(K)::value>(b.lu.data(), b.pivot.data(), k); });
 }
 
 void BlockLU::apply_factors(const Block& b, double* z) {
   const int k = static_cast<int>(b.rows.size());
-  const double* a = b.lu.data();
-  const int* pivot = b.pivot.data();
-  switch (k) {
-    case 1: return substitute_block<1>(a, pivot, z, k);
-    case 2: return substitute_block<2>(a, pivot, z, k);
-    case 3: return substitute_block<3>(a, pivot, z, k);
-    case 4: return substitute_block<4>(a, pivot, z, k);
-    case 5: return substitute_block<5>(a, pivot, z, k);
-    case 6: return substitute_block<6>(a, pivot, z, k);
-    default: return substitute_block<0>(a, pivot, z, k);
-  }
+  with_block_size(k, [&](auto K) { substitute_block<decltype(K)::value>(b.lu.data(), b.pivot.data(), z, k); });
 }
 
 void BlockLU::invert() {
