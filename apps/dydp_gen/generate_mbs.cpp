@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <sstream>
 
+#include "mass_loops_cpp.hpp"
 #include "symbolic/compact.hpp"
 #include "symbolic/differentiate.hpp"
 #include "symbolic/eliminate.hpp"
@@ -175,6 +176,11 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   dynamics.push_back(tangent(name + "_mass", *lists.inertial, {lists.qdd}, /*with_primal=*/false));
   dynamics.push_back(plain(name + "_residual", *lists.applied));
   if (lists.mass_matrix) dynamics.push_back(plain(name + "_mass_matrix", *lists.mass_matrix));
+  if (lists.mass_loops) {
+    std::vector<std::string> joints;
+    for (const auto& j : model.joints) joints.push_back(j.name);
+    for (auto& f : emit_mass_loops(*lists.mass_loops, name, joints, emit, result.functions)) dynamics.push_back(std::move(f));
+  }
   residual_tangent.push_back(tangent(name + "_residual_tangent", *lists.residual, all_seeded));
   auto part = [&](const std::string& label, const EquationList& list, std::size_t from, std::size_t to) {
     EquationList alone(list.context());
@@ -290,6 +296,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += number_array("int", "jacobian_nonzero", jacobian_nonzero);
   // the mass matrix's entries: (row, col) of each output of NAME_mass_matrix, read off its names
   std::vector<int> mass_rows, mass_cols;
+  if (lists.mass_loops) mass_loops_entries(*lists.mass_loops, mass_rows, mass_cols);
   for (const auto& o : lists.mass_matrix ? lists.mass_matrix->outputs() : std::vector<symbolic::Output>{}) {
     const auto comma = o.name.find(',');
     mass_rows.push_back(std::stoi(o.name.substr(2, comma - 2)));
@@ -312,7 +319,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += "    " + std::to_string(model.load_input_count()) + ", load_names, load_widths, sensor_units,\n";
   d += "    jacobian_nonzero, " + name + "_constraints_tangent,\n";
   d += "    " + std::to_string(mass_rows.size()) + ", mass_rows, mass_cols, " +
-       (lists.mass_matrix ? name + "_mass_matrix" : std::string("nullptr")) + ",\n    parameter_units,\n";
+       (lists.mass_matrix || lists.mass_loops ? name + "_mass_matrix" : std::string("nullptr")) + ",\n    parameter_units,\n";
   d += "    " + name + "_sensors_kinematic, " + name + "_sensors_kinematic_tangent, " + name + "_sensors_acceleration, " +
        name + "_sensors_acceleration_tangent};\n\n";
   d += "}  // namespace dydp::generated\n";

@@ -23,6 +23,7 @@ using symbolic::Context;
 using symbolic::Direction;
 using symbolic::EquationList;
 using symbolic::Expr;
+using symbolic::NodeId;
 using symbolic::Output;
 using symbolic::SymbolKind;
 
@@ -74,7 +75,7 @@ class Generator {
     all_ = std::make_unique<EquationList>(ctx);
   }
 
-  void run() {
+  void run(MassForm mass_form) {
     positions();
     velocities();
     std::vector<Expr> qdd, zero(m_.coordinates(), ctx_->zero());
@@ -96,11 +97,14 @@ class Generator {
       return o;
     };
     out_.inertial = std::make_unique<EquationList>(symbolic::eliminate(with_outputs(*all_, outputs("Mqdd", inertial))));
-    if (mass_entry_count() <= kMassEntriesPerCoordinate * static_cast<std::size_t>(m_.coordinates())) {
+    const bool shallow = mass_entry_count() <= kMassEntriesPerCoordinate * static_cast<std::size_t>(m_.coordinates());
+    if (mass_form == MassForm::Entries || (mass_form == MassForm::Automatic && shallow)) {
       std::vector<Output> o;
       for (const MassEntry& e : mass_matrix())
         o.push_back({"M[" + std::to_string(e.row) + "," + std::to_string(e.col) + "]", e.value.id()});
       out_.mass_matrix = merged(o, {}, o);
+    } else {
+      out_.mass_loops = mass_loops();
     }
 
     // The constraint kinematics: h and J from the relative kinematics of the cut points (a joint
@@ -589,8 +593,8 @@ class Generator {
   };
   // Entries of the composite-inertia M: one per joint and each of its ancestors. Their code grows
   // like n times the tree's mean depth; past kMassEntriesPerCoordinate per coordinate (a long
-  // chain: chain200 has 20 100 entries, 321 k operations) M stays the inertial pass's tangent,
-  // whose code is one pass whatever the number of columns.
+  // chain: chain200 has 20 100 entries, 321 k operations) they are written as loops
+  // (mass_loops()), whose code is one loop body per joint.
   static constexpr std::size_t kMassEntriesPerCoordinate = 16;
   std::size_t mass_entry_count() const {
     std::size_t count = 0;
@@ -598,7 +602,8 @@ class Generator {
       for (int k = i; k >= 0; k = m_.joints[k].parent) ++count;
     return count;
   }
-  std::vector<MassEntry> mass_matrix() {
+  // The composite inertia of every joint's subtree about its origin, in its components.
+  std::vector<Composite> composites() {
     const int n = m_.coordinates();
     std::vector<Composite> composite(n);
     for (const int k : m_.order) composite[k] = body_composite(k);
@@ -619,17 +624,29 @@ class Generator {
       p.moment = p.moment + moved.moment;
       p.inertia = sym_from([&](int a, int b) { return p.inertia.at(a, b) + moved.inertia.at(a, b); });
     }
+    return composite;
+  }
+  // The force and torque (about its origin, its components) joint i's unit acceleration needs
+  // on its subtree: revolute axis e: F = e x h, N = J e; prismatic: F = m e, N = h x e.
+  std::pair<V3, V3> unit_wrench(int i, const Composite& c) {
+    const V3 e = joint_axis(i);
+    if (is_revolute(m_.joints[i].type)) return {cross(e, c.moment), c.inertia.apply(e)};
+    return {c.mass * e, cross(c.moment, e)};
+  }
+  // M(i, k) from joint i's wrench in joint k's frame: k's axis against N (revolute) or F.
+  Expr mass_entry(int k, const V3& F, const V3& N) {
+    const V3 axis = joint_axis(k);
+    return is_revolute(m_.joints[k].type) ? dot(axis, N) : dot(axis, F);
+  }
+  std::vector<MassEntry> mass_matrix() {
+    const int n = m_.coordinates();
+    const std::vector<Composite> composite = composites();
     std::vector<MassEntry> entries;
     for (int i = 0; i < n; ++i) {
-      const Composite& c = composite[i];
-      const V3 e = joint_axis(i);
-      const bool revolute = is_revolute(m_.joints[i].type);
-      V3 F = revolute ? cross(e, c.moment) : c.mass * e;
-      V3 N = revolute ? c.inertia.apply(e) : cross(c.moment, e);
+      const std::pair<V3, V3> wrench = unit_wrench(i, composite[i]);
+      V3 F = wrench.first, N = wrench.second;
       auto entry = [&](int k) {
-        const V3 axis = joint_axis(k);
-        const Expr v = is_revolute(m_.joints[k].type) ? dot(axis, N) : dot(axis, F);
-        entries.push_back({i, k, all_->assign("MM" + std::to_string(i + 1) + "_" + std::to_string(k + 1), v)});
+        entries.push_back({i, k, all_->assign("MM" + std::to_string(i + 1) + "_" + std::to_string(k + 1), mass_entry(k, F, N))});
       };
       entry(i);
       for (int k = i; m_.joints[k].parent >= 0; k = m_.joints[k].parent) {
@@ -642,6 +659,94 @@ class Generator {
       }
     }
     return entries;
+  }
+
+  // The same recursion with its sweeps as loops (MassLoops): the lanes in depth-first order,
+  // then for each joint k below a root, deepest first, the lanes of k's subtree (all in k's
+  // frame by then) carried to its parent's frame, F' = R F, N' = R N + r x F', and
+  // M(i, parent) read off them. The sweeps' expressions are in placeholders, so that their code
+  // is one loop body per joint whatever the number of lanes it carries.
+  std::unique_ptr<MassLoops> mass_loops() {
+    const int n = m_.coordinates();
+    auto loops = std::make_unique<MassLoops>();
+    std::vector<std::vector<int>> children(n);
+    std::vector<int> roots;
+    for (int k = 0; k < n; ++k) (m_.joints[k].parent < 0 ? roots : children[m_.joints[k].parent]).push_back(k);
+    std::vector<int> position(n), size(n, 1);
+    std::vector<int> stack(roots.rbegin(), roots.rend());
+    while (!stack.empty()) {
+      const int k = stack.back();
+      stack.pop_back();
+      position[k] = static_cast<int>(loops->lane_joint.size());
+      loops->lane_joint.push_back(k);
+      for (auto c = children[k].rbegin(); c != children[k].rend(); ++c) stack.push_back(*c);
+    }
+    for (auto t = loops->lane_joint.rbegin(); t != loops->lane_joint.rend(); ++t)
+      if (m_.joints[*t].parent >= 0) size[m_.joints[*t].parent] += size[*t];
+
+    const std::vector<Composite> composite = composites();
+    std::vector<Output> o(7 * static_cast<std::size_t>(n));
+    for (int t = 0; t < n; ++t) {
+      const int i = loops->lane_joint[t];
+      const std::pair<V3, V3> wrench = unit_wrench(i, composite[i]);
+      const V3& F = wrench.first;
+      const V3& N = wrench.second;
+      const std::string tag = std::to_string(i + 1);
+      for (int a = 0; a < 3; ++a) {
+        o[a * n + t] = {"F" + std::to_string(a + 1) + "[" + tag + "]", F[a].id()};
+        o[(a + 3) * n + t] = {"N" + std::to_string(a + 1) + "[" + tag + "]", N[a].id()};
+      }
+      o[6 * n + t] = {"M[" + std::to_string(i) + "," + std::to_string(i) + "]", mass_entry(i, F, N).id()};
+    }
+    V3 F, N, Fm, Nm;
+    for (int a = 0; a < 3; ++a) {
+      F[a] = ctx_->aux("mf" + std::to_string(a + 1));
+      N[a] = ctx_->aux("mn" + std::to_string(a + 1));
+      Fm[a] = ctx_->aux("mg" + std::to_string(a + 1));
+      Nm[a] = ctx_->aux("mh" + std::to_string(a + 1));
+      loops->lane[a] = F[a].id();
+      loops->lane[a + 3] = N[a].id();
+      loops->moved_lane[a] = Fm[a].id();
+      loops->moved_lane[a + 3] = Nm[a].id();
+    }
+    for (auto t = loops->lane_joint.rbegin(); t != loops->lane_joint.rend(); ++t) {
+      const int k = *t, parent = m_.joints[k].parent;
+      if (parent < 0) continue;
+      MassLoops::Sweep sweep{k, parent, position[k], position[k] + size[k]};
+      const V3 f = rotate(k, F), moment = rotate(k, N) + cross(offset_[k], Fm);
+      for (int a = 0; a < 3; ++a) {
+        sweep.moved[a] = f[a].id();
+        sweep.moved[a + 3] = moment[a].id();
+      }
+      sweep.entry = mass_entry(parent, Fm, Nm).id();
+      loops->sweeps.push_back(sweep);
+    }
+
+    // What the sweeps read besides the placeholders and the function's arrays: auxiliaries
+    // (an arbitrary axis's rotation, an offset along a prismatic joint) and sin/cos.
+    std::vector<char> placeholder(ctx_->size(), 0), seen(ctx_->size(), 0);
+    for (int a = 0; a < 6; ++a) placeholder[loops->lane[a]] = placeholder[loops->moved_lane[a]] = 1;
+    std::vector<NodeId> pending;
+    for (const MassLoops::Sweep& sweep : loops->sweeps) {
+      pending.insert(pending.end(), sweep.moved.begin(), sweep.moved.end());
+      pending.push_back(sweep.entry);
+    }
+    while (!pending.empty()) {
+      const NodeId x = pending.back();
+      pending.pop_back();
+      if (seen[x]) continue;
+      seen[x] = 1;
+      if (placeholder[x]) continue;
+      if (ctx_->is_abbreviation(x) || ctx_->is_symbol(x, SymbolKind::Aux)) {
+        loops->reads.push_back(x);
+        o.push_back({"read " + std::to_string(loops->reads.size() - 1), x});
+        continue;
+      }
+      const auto c = ctx_->children(x);
+      pending.insert(pending.end(), c.begin(), c.end());
+    }
+    loops->start = std::make_unique<EquationList>(symbolic::eliminate(with_outputs(*all_, std::move(o))));
+    return loops;
   }
 
   // Every cut's equations are written in the frame of the nearest joint frame that carries both
@@ -1072,9 +1177,9 @@ class Generator {
 
 }  // namespace
 
-ModelLists build_model_lists(const Model& model) {
+ModelLists build_model_lists(const Model& model, MassForm mass_form) {
   ModelLists lists;
-  Generator(model, lists).run();
+  Generator(model, lists).run(mass_form);
   return lists;
 }
 

@@ -1,0 +1,117 @@
+// The mass matrix's loops as C++ (see mass_loops_cpp.hpp).
+#include "mass_loops_cpp.hpp"
+
+#include "symbolic/op_count.hpp"
+
+namespace dydp::gen {
+namespace {
+
+using namespace dydp::symbolic;
+
+const char* const kLaneNames[6] = {"F1", "F2", "F3", "N1", "N2", "N3"};
+
+// The operations of one sweep's body for one lane (sin and cos are read, not called).
+OpCount body_ops(Context& ctx, const mbs::MassLoops& loops, const mbs::MassLoops::Sweep& sweep) {
+  EquationList body(ctx);
+  for (int a = 0; a < 6; ++a)
+    if (sweep.moved[a] != loops.lane[a]) body.add_output("moved", ctx.expr(sweep.moved[a]));
+  body.add_output("entry", ctx.expr(sweep.entry));
+  OpCount ops = count_ops(body);
+  ops.call = 0;
+  return ops;
+}
+
+}  // namespace
+
+void mass_loops_entries(const mbs::MassLoops& loops, std::vector<int>& rows, std::vector<int>& cols) {
+  rows.clear();
+  cols.clear();
+  for (int j : loops.lane_joint) {
+    rows.push_back(j);
+    cols.push_back(j);
+  }
+  for (const auto& sweep : loops.sweeps)
+    for (int t = sweep.begin; t < sweep.end; ++t) {
+      rows.push_back(loops.lane_joint[t]);
+      cols.push_back(sweep.parent);
+    }
+}
+
+std::vector<EmittedFunction> emit_mass_loops(const mbs::MassLoops& loops, const std::string& name,
+                                             const std::vector<std::string>& joints, EmitOptions emit,
+                                             std::vector<FunctionStats>& stats) {
+  Context& ctx = loops.start->context();
+  const std::size_t n = loops.lane_joint.size();
+  const std::string start_name = name + "_mass_start";
+  std::vector<EmittedFunction> functions;
+
+  emit.function_name = start_name;
+  functions.push_back(emit_function(*loops.start, emit));
+  FunctionStats start_stats{start_name, loops.start->size(), loops.start->size(), count_ops(*loops.start)};
+  measure_text(functions.back().definition, start_stats);
+
+  emit.function_name = name + "_mass_matrix";
+  EmittedFunction f = emit_function(EquationList(ctx), emit);  // the signature
+  FunctionStats stats_loops{f.name, 0, loops.sweeps.size(), start_stats.ops};
+  const std::string total = std::to_string(7 * n + loops.reads.size());
+  std::string body;
+  body += "// " + f.name + ": M by composite inertias, from " + start_name +
+          "'s lanes (one joint's unit-acceleration\n"
+          "// wrench each, in depth-first order) carried to each ancestor's frame by one loop per joint.\n"
+          "// Entries: M(j, j) by lane, then each loop's, as listed in mass_rows and mass_cols.\n";
+  body += f.declaration.substr(0, f.declaration.size() - 2) + "\n{\n";
+  body += "  typedef double V2 __attribute__((vector_size(16)));\n";
+  body += "  // two lanes, or one (the other zero) at the end of an odd loop\n";
+  body += "  const auto load = [](const double* x, bool two) {\n"
+          "    V2 v = {x[0], 0.0};\n"
+          "    if (two) __builtin_memcpy(&v, x, sizeof v);\n"
+          "    return v;\n"
+          "  };\n";
+  body += "  const auto store = [](double* x, V2 v, bool two) {\n"
+          "    if (two) __builtin_memcpy(x, &v, sizeof v);\n"
+          "    else x[0] = v[0];\n"
+          "  };\n";
+  body += "  double start[" + total + "];\n";
+  body += "  " + start_name + "(";
+  for (ArrayId a = 0; a < ctx.array_count(); ++a)
+    if (ctx.array(a).kind != SymbolKind::Seed) body += ctx.array(a).name + ", ";
+  body += "start);\n";
+  for (int a = 0; a < 6; ++a)
+    body += "  double* const " + std::string(kLaneNames[a]) + " = start + " + std::to_string(a * n) + ";\n";
+  body += "  for (int t = 0; t < " + std::to_string(n) + "; ++t) out[t] = start[" + std::to_string(6 * n) + " + t];\n";
+  for (std::size_t r = 0; r < loops.reads.size(); ++r)
+    body += "  const double " + to_cpp(ctx, loops.reads[r]) + " = start[" + std::to_string(7 * n + r) + "];\n";
+
+  std::size_t at = n;  // the next entry
+  for (const auto& sweep : loops.sweeps) {
+    const std::string b = std::to_string(sweep.begin), e = std::to_string(sweep.end);
+    const std::size_t lanes = static_cast<std::size_t>(sweep.end - sweep.begin);
+    body += "  // " + joints[sweep.joint] + "'s subtree, lanes " + b + " to " + std::to_string(sweep.end - 1) + ", to " +
+            joints[sweep.parent] + "'s frame: M(., " + joints[sweep.parent] + ")\n";
+    body += "  for (int t = " + b + "; t < " + e + "; t += 2) {\n";
+    body += "    const bool two = t + 1 < " + e + ";\n";
+    for (int a = 0; a < 6; ++a)
+      body += "    const V2 " + ctx.symbol(loops.lane[a]).name + " = load(" + kLaneNames[a] + " + t, two);\n";
+    for (int a = 0; a < 6; ++a)
+      body += "    const V2 " + ctx.symbol(loops.moved_lane[a]).name + " = " + to_cpp(ctx, sweep.moved[a]) + ";\n";
+    for (int a = 0; a < 6; ++a)
+      if (sweep.moved[a] != loops.lane[a])
+        body += "    store(" + std::string(kLaneNames[a]) + " + t, " + ctx.symbol(loops.moved_lane[a]).name + ", two);\n";
+    body += "    store(out + " + std::to_string(at) + " + (t - " + b + "), " + to_cpp(ctx, sweep.entry) + ", two);\n";
+    body += "  }\n";
+    at += lanes;
+    const OpCount ops = body_ops(ctx, loops, sweep);
+    stats_loops.ops.add += ops.add * lanes;
+    stats_loops.ops.mul += ops.mul * lanes;
+    stats_loops.ops.div += ops.div * lanes;
+  }
+  body += "}\n";
+  f.definition = body;
+  measure_text(f.definition, stats_loops);
+  stats.push_back(start_stats);
+  stats.push_back(stats_loops);
+  functions.push_back(f);
+  return functions;
+}
+
+}  // namespace dydp::gen
