@@ -845,11 +845,33 @@ class Generator {
           add_row(values);
         }
       } else {
-        // h = (d.d - L^2) / 2L: dh/dq_j = d . dd/dq_j / L
-        const V3 d = cut_vector(ci);
-        const Expr inverse_length = 1.0 / val(c.length);
+        // h = (d.d - L^2) / 2L: dh/dq_j = d/L . dd/dq_j, where a revolute joint turning a
+        // point P about its origin o gives d/L . (e x (P - o)) = e . ((P - o) x d/L): the
+        // joints that turn P about one origin (a ball joint's three revolutes) share that
+        // moment, and each adds one dot product with its axis.
+        const int frame = cut_frame(c);
+        const V3 scaled = assign("DS" + std::to_string(ci + 1) + "_", 0, (1.0 / val(c.length)) * cut_vector(ci));
         std::vector<Expr> values(n, ctx_->zero());
-        for (const auto& [j, rate] : rates) values[j] = dot(d, rate) * inverse_length;
+        auto turn = [&](PointRef point, double sign) {
+          std::map<std::array<NodeId, 3>, V3> moments;  // (P - o) x d/L by origin o
+          for (int j : path_to(m_.bodies[point.body].frame, frame)) {
+            const V3 e = relative_placement(m_.joints[j].parent, frame).rot.apply(joint_axis(j));
+            if (!is_revolute(m_.joints[j].type)) {
+              values[j] = values[j] + sign * dot(e, scaled);
+              continue;
+            }
+            const V3 o = relative_placement(j, frame).origin;
+            const std::array<NodeId, 3> key{o[0].id(), o[1].id(), o[2].id()};
+            auto it = moments.find(key);
+            if (it == moments.end()) {
+              const std::string tag = "DW" + std::to_string(ci + 1) + (sign > 0 ? "b" : "a") + "_";
+              it = moments.emplace(key, assign(tag, j, cross(point_in(point, frame) - o, scaled))).first;
+            }
+            values[j] = values[j] + sign * dot(e, it->second);
+          }
+        };
+        turn(c.b, 1.0);
+        turn(c.a, -1.0);
         add_row(values);
       }
     }
