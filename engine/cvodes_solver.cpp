@@ -22,6 +22,7 @@
 #include "engine/cpu_clock.hpp"
 #include "engine/dense_lu_solver.hpp"
 #include "engine/errors.hpp"
+#include "engine/jacobian_colouring.hpp"
 #include "engine/timeline.hpp"
 #include "engine/recorder.hpp"
 #include "engine/step_limiters.hpp"
@@ -34,14 +35,15 @@ namespace {
 struct Problem {
   Problem(const Diagram& diagram, Evaluator& evaluator, int states, int directions)
       : d(diagram), ev(evaluator), nx(states), nq(diagram.num_quadratures), ny(std::max(states + nq, 1)),
-        ns(directions) {}
+        ns(directions), colouring(diagram) {}
   const Diagram& d;
   Evaluator& ev;
   int nx;                 ///< states of the diagram
   int nq;                 ///< objective integrals, after the states in CVODES' vector
   int ny;                 ///< CVODES' vector: max(nx + nq, 1)
   int ns;
-  std::vector<double> dx, dxdot, identity;
+  std::vector<double> dx, dxdot;
+  JacobianColouring colouring;  ///< the Jacobian's tangent passes, one per colour
   std::string refusal;    ///< last block that refused a point: "block: reason"
   double refusal_t = 0.0;
   std::string cvodes_message;
@@ -120,8 +122,7 @@ int jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix J, void* user, N_Vec
   if (P.nx == 0) return 0;
   return guarded(P, t, [&] {
     const int ld = static_cast<int>(SM_ROWS_D(J));
-    P.ev.tangents(t, NV_DATA_S(y), P.nx, {P.identity.data(), P.nx}, false, {SM_DATA_D(J), ld},
-                  {SM_DATA_D(J) + P.nx, ld});
+    P.colouring.evaluate(P.ev, t, NV_DATA_S(y), {SM_DATA_D(J), ld}, {SM_DATA_D(J) + P.nx, ld});
     ++P.jac_passes;
   });
 }
@@ -166,8 +167,6 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   RunResult result;
   Recorder recorder(d, ns, result, options);
   Problem P(d, ev, nx, ns);
-  P.identity.assign(static_cast<size_t>(nx) * nx, 0.0);
-  for (int i = 0; i < nx; ++i) P.identity[i * nx + i] = 1.0;
   const CpuClock clock;
 
   Sundials S;
@@ -255,6 +254,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
     CVodeGetNumNonlinSolvIters(S.mem, &v), st.nonlinear_iterations += v;
     CVodeGetNumNonlinSolvConvFails(S.mem, &v), st.nonlinear_failures += v;
     if (bdf) CVodeGetNumJacEvals(S.mem, &v), st.jac_evals += v;
+    st.jacobian_colours = P.colouring.colours();
   };
 
   // Record at t0, then march over outputs and breakpoints; restart CVODES after each breakpoint

@@ -86,6 +86,7 @@ std::string run_json(const Diagram& d, const RunResult& r) {
       {"rhs_evaluations", s.rhs_evals},
       {"sensitivity_rhs_evaluations", s.sens_rhs_evals},
       {"jacobian_evaluations", s.jac_evals},
+      {"jacobian_colours", s.jacobian_colours},
       {"local_jacobian_refreshes", s.local_jac_evals},
       {"substeps", s.substeps},
       {"error_test_failures", s.error_test_failures},

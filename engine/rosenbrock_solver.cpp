@@ -7,6 +7,7 @@
 
 #include "engine/cpu_clock.hpp"
 #include "engine/errors.hpp"
+#include "engine/jacobian_colouring.hpp"
 #include "engine/recorder.hpp"
 #include "engine/timeline.hpp"
 #include "engine/tolerances.hpp"
@@ -59,7 +60,8 @@ class Ros2Stepper {
  public:
   Ros2Stepper(const Diagram& d, Evaluator& ev, int ns, RunStats& stats, const std::vector<double>* fixed_w)
       : ev_(ev), nx_(d.num_states), nq_(d.num_quadratures), ns_(ns), stats_(stats), fixed_(fixed_w != nullptr),
-        w_(nx_, nx_), identity_(Matrix::Identity(nx_, nx_)) {
+        w_(nx_, nx_), identity_(Matrix::Identity(nx_, nx_)), colouring_(d) {
+    stats_.jacobian_colours = colouring_.colours();
     const std::vector<double> nominal = state_nominals(d);
     scale_ = Eigen::Map<const Vector>(nominal.data(), nx_);
     if (fixed_) w_ = Eigen::Map<const Matrix>(fixed_w->data(), nx_, nx_);
@@ -203,11 +205,11 @@ class Ros2Stepper {
     }
   }
 
-  /// W = df/dx at (t, y), one tangent pass with the identity as state seeds.
+  /// W = df/dx at (t, y): one tangent pass per colour of its columns (JacobianColouring).
   void refresh(double t_at, const Vector& y) {
     if (nx_ == 0) return;
     try {
-      ev_.tangents(t_at, y.data(), nx_, {identity_.data(), nx_}, false, {w_.data(), nx_}, {});
+      colouring_.evaluate(ev_, t_at, y.data(), {w_.data(), nx_}, {});
     } catch (const OutOfDomain& e) {
       throw domain_failure(t_at, e);
     }
@@ -257,6 +259,7 @@ class Ros2Stepper {
   RunStats& stats_;
   bool fixed_;
   Matrix w_, identity_;
+  JacobianColouring colouring_;
   Eigen::PartialPivLU<Matrix> lu_;
   double factored_h_ = -1.0;
   int age_ = 0;                    ///< steps taken since W was evaluated

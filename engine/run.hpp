@@ -36,7 +36,10 @@ struct RunStats {
   long steps = 0;
   long rhs_evals = 0;             ///< value passes for state derivatives
   long sens_rhs_evals = 0;        ///< tangent passes for the sensitivity equations
-  long jac_evals = 0;             ///< Jacobians (each one tangent pass over all states)
+  long jac_evals = 0;             ///< Jacobians (each one tangent pass over jacobian_colours directions)
+  /// Directions of a Jacobian's tangent pass: the colours of its columns (columns whose rows do
+  /// not meet share one, engine/jacobian_colouring.hpp), the states when none can share.
+  int jacobian_colours = 0;
   long local_jac_evals = 0;       ///< refreshes of the blocks' own diagonal Jacobian blocks only
   long error_test_failures = 0;
   long nonlinear_iterations = 0;

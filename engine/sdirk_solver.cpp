@@ -8,6 +8,7 @@
 
 #include "engine/cpu_clock.hpp"
 #include "engine/errors.hpp"
+#include "engine/jacobian_colouring.hpp"
 #include "engine/timeline.hpp"
 #include "engine/recorder.hpp"
 
@@ -39,11 +40,13 @@ class Stepper {
  public:
   Stepper(const Diagram& d, Evaluator& ev, int ns, RunStats& stats)
       : d_(d), ev_(ev), nx_(d.num_states), nq_(d.num_quadratures), ns_(ns), stats_(stats),
-        jac_(nx_, nx_), identity_(Matrix::Identity(nx_, nx_)) {}
+        jac_(nx_, nx_), identity_(Matrix::Identity(nx_, nx_)), colouring_(d) {
+    stats_.jacobian_colours = colouring_.colours();
+  }
 
-  /// J = df/dx at (t, y) from one tangent pass with the identity as state seeds.
+  /// J = df/dx at (t, y): one tangent pass per colour of its columns (JacobianColouring).
   void jacobian(double t, const Vector& y) {
-    ev_.tangents(t, y.data(), nx_, {identity_.data(), nx_}, false, {jac_.data(), nx_}, {});
+    colouring_.evaluate(ev_, t, y.data(), {jac_.data(), nx_}, {});
     ++stats_.jac_evals;
   }
   /// Refreshes only the diagonal blocks of J that blocks provide cheaply (Block::local_jacobian).
@@ -155,6 +158,7 @@ class Stepper {
   int nx_, nq_, ns_;
   RunStats& stats_;
   Matrix jac_, identity_;
+  JacobianColouring colouring_;
   Eigen::PartialPivLU<Matrix> lu_;
   double factored_hg_ = -1.0;
   bool has_local_ = true;  ///< some block provides a local Jacobian (until found otherwise)
