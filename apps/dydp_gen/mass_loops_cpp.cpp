@@ -1,6 +1,10 @@
 // The mass matrix's loops as C++ (see mass_loops_cpp.hpp).
 #include "mass_loops_cpp.hpp"
 
+#include <algorithm>
+#include <unordered_map>
+#include <unordered_set>
+
 #include "symbolic/op_count.hpp"
 
 namespace dydp::gen {
@@ -54,57 +58,82 @@ std::vector<EmittedFunction> emit_mass_loops(const mbs::MassLoops& loops, const 
   EmittedFunction f = emit_function(EquationList(ctx), emit);  // the signature
   FunctionStats stats_loops{f.name, 0, loops.sweeps.size(), start_stats.ops};
   const std::string total = std::to_string(7 * n + loops.reads.size());
+  const std::string lanes_type = name + "_lanes", load = name + "_load", store = name + "_store";
   std::string body;
-  body += "// " + f.name + ": M by composite inertias, from " + start_name +
-          "'s lanes (one joint's unit-acceleration\n"
-          "// wrench each, in depth-first order) carried to each ancestor's frame by one loop per joint.\n"
-          "// Entries: M(j, j) by lane, then each loop's, as listed in mass_rows and mass_cols.\n";
-  body += f.declaration.substr(0, f.declaration.size() - 2) + "\n{\n";
-  body += "  typedef double V2 __attribute__((vector_size(16)));\n";
-  body += "  // two lanes, or one (the other zero) at the end of an odd loop\n";
-  body += "  const auto load = [](const double* x, bool two) {\n"
-          "    V2 v = {x[0], 0.0};\n"
-          "    if (two) __builtin_memcpy(&v, x, sizeof v);\n"
-          "    return v;\n"
-          "  };\n";
-  body += "  const auto store = [](double* x, V2 v, bool two) {\n"
-          "    if (two) __builtin_memcpy(x, &v, sizeof v);\n"
-          "    else x[0] = v[0];\n"
-          "  };\n";
-  body += "  double start[" + total + "];\n";
-  body += "  " + start_name + "(";
-  for (ArrayId a = 0; a < ctx.array_count(); ++a)
-    if (ctx.array(a).kind != SymbolKind::Seed) body += ctx.array(a).name + ", ";
-  body += "start);\n";
-  for (int a = 0; a < 6; ++a)
-    body += "  double* const " + std::string(kLaneNames[a]) + " = start + " + std::to_string(a * n) + ";\n";
-  body += "  for (int t = 0; t < " + std::to_string(n) + "; ++t) out[t] = start[" + std::to_string(6 * n) + " + t];\n";
-  for (std::size_t r = 0; r < loops.reads.size(); ++r)
-    body += "  const double " + to_cpp(ctx, loops.reads[r]) + " = start[" + std::to_string(7 * n + r) + "];\n";
-
+  // One small function per loop: a compiler's time on one function with every loop grows
+  // faster than linearly (clang with AddressSanitizer took minutes on chain200's).
+  body += "// " + f.name + "'s loops: two lanes at a time, or one (the other zero) at the end of an odd loop\n";
+  body += "typedef double " + lanes_type + " __attribute__((vector_size(16)));\n";
+  body += "static inline " + lanes_type + " " + load + "(const double* x, bool two) noexcept\n{\n"
+          "  " + lanes_type + " v = {x[0], 0.0};\n"
+          "  if (two) __builtin_memcpy(&v, x, sizeof v);\n"
+          "  return v;\n}\n";
+  body += "static inline void " + store + "(double* x, " + lanes_type + " v, bool two) noexcept\n{\n"
+          "  if (two) __builtin_memcpy(x, &v, sizeof v);\n"
+          "  else x[0] = v[0];\n}\n";
+  std::unordered_map<NodeId, std::size_t> read_index;
+  for (std::size_t r = 0; r < loops.reads.size(); ++r) read_index[loops.reads[r]] = r;
+  std::string calls;
   std::size_t at = n;  // the next entry
-  for (const auto& sweep : loops.sweeps) {
+  for (std::size_t k = 0; k < loops.sweeps.size(); ++k) {
+    const auto& sweep = loops.sweeps[k];
     const std::string b = std::to_string(sweep.begin), e = std::to_string(sweep.end);
+    const std::string sweep_name = name + "_mass_sweep" + std::to_string(k + 1);
     const std::size_t lanes = static_cast<std::size_t>(sweep.end - sweep.begin);
-    body += "  // " + joints[sweep.joint] + "'s subtree, lanes " + b + " to " + std::to_string(sweep.end - 1) + ", to " +
+    body += "// " + joints[sweep.joint] + "'s subtree, lanes " + b + " to " + std::to_string(sweep.end - 1) + ", to " +
             joints[sweep.parent] + "'s frame: M(., " + joints[sweep.parent] + ")\n";
+    body += "static void " + sweep_name + "(double* start, double* out) noexcept\n{\n";
+    // the values this loop reads besides its lanes
+    std::vector<NodeId> pending(sweep.moved.begin(), sweep.moved.end());
+    pending.push_back(sweep.entry);
+    std::vector<std::size_t> used;
+    std::unordered_set<NodeId> seen;
+    while (!pending.empty()) {
+      const NodeId x = pending.back();
+      pending.pop_back();
+      if (!seen.insert(x).second) continue;
+      if (const auto it = read_index.find(x); it != read_index.end()) {
+        used.push_back(it->second);
+        continue;
+      }
+      const auto c = ctx.children(x);
+      pending.insert(pending.end(), c.begin(), c.end());
+    }
+    std::sort(used.begin(), used.end());
+    for (std::size_t r : used)
+      body += "  const double " + to_cpp(ctx, loops.reads[r]) + " = start[" + std::to_string(7 * n + r) + "];\n";
+    for (int a = 0; a < 6; ++a)
+      body += "  double* const " + std::string(kLaneNames[a]) + " = start + " + std::to_string(a * n) + ";\n";
     body += "  for (int t = " + b + "; t < " + e + "; t += 2) {\n";
     body += "    const bool two = t + 1 < " + e + ";\n";
     for (int a = 0; a < 6; ++a)
-      body += "    const V2 " + ctx.symbol(loops.lane[a]).name + " = load(" + kLaneNames[a] + " + t, two);\n";
+      body += "    const " + lanes_type + " " + ctx.symbol(loops.lane[a]).name + " = " + load + "(" + kLaneNames[a] + " + t, two);\n";
     for (int a = 0; a < 6; ++a)
-      body += "    const V2 " + ctx.symbol(loops.moved_lane[a]).name + " = " + to_cpp(ctx, sweep.moved[a]) + ";\n";
+      body += "    const " + lanes_type + " " + ctx.symbol(loops.moved_lane[a]).name + " = " + to_cpp(ctx, sweep.moved[a]) + ";\n";
     for (int a = 0; a < 6; ++a)
       if (sweep.moved[a] != loops.lane[a])
-        body += "    store(" + std::string(kLaneNames[a]) + " + t, " + ctx.symbol(loops.moved_lane[a]).name + ", two);\n";
-    body += "    store(out + " + std::to_string(at) + " + (t - " + b + "), " + to_cpp(ctx, sweep.entry) + ", two);\n";
-    body += "  }\n";
+        body += "    " + store + "(" + std::string(kLaneNames[a]) + " + t, " + ctx.symbol(loops.moved_lane[a]).name + ", two);\n";
+    body += "    " + store + "(out + " + std::to_string(at) + " + (t - " + b + "), " + to_cpp(ctx, sweep.entry) + ", two);\n";
+    body += "  }\n}\n";
+    calls += "  " + sweep_name + "(start, out);\n";
     at += lanes;
     const OpCount ops = body_ops(ctx, loops, sweep);
     stats_loops.ops.add += ops.add * lanes;
     stats_loops.ops.mul += ops.mul * lanes;
     stats_loops.ops.div += ops.div * lanes;
   }
+  body += "// " + f.name + ": M by composite inertias, from " + start_name +
+          "'s lanes (one joint's unit-acceleration\n"
+          "// wrench each, in depth-first order) carried to each ancestor's frame by one loop per joint,\n"
+          "// deepest first. Entries: M(j, j) by lane, then each loop's, as listed in mass_rows and mass_cols.\n";
+  body += f.declaration.substr(0, f.declaration.size() - 2) + "\n{\n";
+  body += "  double start[" + total + "];\n";
+  body += "  " + start_name + "(";
+  for (ArrayId a = 0; a < ctx.array_count(); ++a)
+    if (ctx.array(a).kind != SymbolKind::Seed) body += ctx.array(a).name + ", ";
+  body += "start);\n";
+  body += "  for (int t = 0; t < " + std::to_string(n) + "; ++t) out[t] = start[" + std::to_string(6 * n) + " + t];\n";
+  body += calls;
   body += "}\n";
   f.definition = body;
   measure_text(f.definition, stats_loops);
