@@ -3,6 +3,8 @@
 #include "symbolic/differentiate.hpp"
 
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 #include "symbolic/eliminate.hpp"
 
@@ -13,9 +15,11 @@ constexpr NodeId kUnset = 0xFFFFFFFFu;
 
 class Differentiator {
  public:
-  Differentiator(Context& ctx, std::size_t known_nodes)
+  // `list`, `suffix`: where the derivatives of the sin/cos abbreviations are assigned (see
+  // compute()); null: they stay expressions.
+  Differentiator(Context& ctx, std::size_t known_nodes, EquationList* list = nullptr, std::string suffix = "")
       : ctx_(ctx), derivative_(known_nodes, kUnset),
-        zero_(ctx.constant(0.0).id()), one_(ctx.constant(1.0).id()) {}
+        zero_(ctx.constant(0.0).id()), one_(ctx.constant(1.0).id()), list_(list), suffix_(std::move(suffix)) {}
 
   void set(NodeId symbol, NodeId derivative) { derivative_.at(symbol) = derivative; }
   NodeId zero() const { return zero_; }
@@ -84,8 +88,14 @@ class Differentiator {
         if (dk[0] != zero_) inner = add(inner, div(mul(y, dk[0]), x));
         return mul(n, inner);
       }
-      case Op::Sin: return mul(fn(Op::Cos, kids[0]), dk[0]);
-      case Op::Cos: return neg(mul(fn(Op::Sin, kids[0]), dk[0]));
+      case Op::Sin:
+      case Op::Cos: {
+        const NodeId rate = op == Op::Sin ? mul(fn(Op::Cos, kids[0]), dk[0]) : neg(mul(fn(Op::Sin, kids[0]), dk[0]));
+        // An abbreviation's derivative (S3_d = C3*dq3) is an auxiliary of its own: products
+        // that read it would otherwise absorb its two factors and multiply them again each.
+        if (list_ && ctx_.is_abbreviation(n)) return list_->assign(ctx_.abbreviation_name(n) + "_" + suffix_, ctx_.expr(rate)).id();
+        return rate;
+      }
       case Op::Tan: return mul(add(one_, mul(n, n)), dk[0]);
       case Op::Atan2: {
         // atan2(y, x)' = (x y' - y x') / (x^2 + y^2)
@@ -118,6 +128,8 @@ class Differentiator {
   Context& ctx_;
   std::vector<NodeId> derivative_;
   NodeId zero_, one_;
+  EquationList* list_;
+  std::string suffix_;
 };
 
 }  // namespace
@@ -150,7 +162,7 @@ EquationList differentiate(const EquationList& list, std::span<const Direction> 
 
   std::vector<Output> derivative_outputs;
   for (const Direction& dir : directions) {
-    Differentiator diff(ctx, ctx.size());
+    Differentiator diff(ctx, ctx.size(), &result, dir.suffix);
     for (const auto& [symbol, seed] : dir.seeds) diff.set(symbol, seed);
     for (const Assignment& a : list.assignments()) {
       const NodeId da = diff.d(a.value);
