@@ -15,9 +15,9 @@
 // (so scenes can make them sensitivity directions).
 #include <algorithm>
 #include <cmath>
-#include <initializer_list>
 #include <mutex>
 
+#include "blocks/direction_plan.hpp"
 #include "engine/registry.hpp"
 #include "generated_models/registry.hpp"
 #include "symbolic/mbs/reduced_dynamics.hpp"
@@ -169,23 +169,25 @@ class Multibody : public Block {
       } else {
         const auto sensors = group ? g_.sensors_acceleration_tangent : g_.sensors_kinematic_tangent;
         Work& w = work_;
-        if (group == 0) live_columns({&dq, &dqd, &dinp, &dp}, nd, w.live);
-        else live_columns({&dq, &dqd, &dqdd, &dinp, &dp}, nd, w.live);
-        const int nl = static_cast<int>(w.live.size());
-        if (nl == nd) {
+        // the directions with nonzero seeds, as in tangent(); the positions' group reads no qdd,
+        // so directions seeded on one load entry share a pass there (the accelerations' group
+        // reads their dqdd, which differ)
+        if (group == 0) w.plan.build({&dq, &dqd, &dinp, &dp}, nd, 2, g_.load_inputs);
+        else w.plan.build({&dq, &dqd, &dqdd, &dinp, &dp}, nd);
+        if (w.plan.whole()) {
           sensors(r.q.data(), r.qd.data(), r.qdd.data(), lam, w.in.data(), parameters(e), nd, dq.data(), dqd.data(),
                   dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
-        } else {  // the directions with nonzero seeds only, as in tangent()
-          gather(dq, w.live, w.c_dq), gather(dqd, w.live, w.c_dqd), gather(dqdd, w.live, w.c_dqdd);
-          gather(dinp, w.live, w.c_dinp), gather(dp, w.live, w.c_dp);
-          w.c_dout.resize(static_cast<std::size_t>(std::max(1, ns)) * std::max(1, nl));
-          if (nl > 0)
-            sensors(r.q.data(), r.qd.data(), r.qdd.data(), lam, w.in.data(), parameters(e), nl, w.c_dq.data(),
+        } else {
+          const int np = w.plan.passes();
+          const int at_inp = group == 0 ? 2 : 3, at_dp = group == 0 ? 3 : 4;
+          w.plan.gather(dq, 0, w.c_dq), w.plan.gather(dqd, 1, w.c_dqd);
+          w.plan.gather(dqdd, group == 0 ? -1 : 2, w.c_dqdd);
+          w.plan.gather(dinp, at_inp, w.c_dinp), w.plan.gather(dp, at_dp, w.c_dp);
+          w.c_dout.resize(static_cast<std::size_t>(std::max(1, ns)) * std::max(1, np));
+          if (np > 0)
+            sensors(r.q.data(), r.qd.data(), r.qdd.data(), lam, w.in.data(), parameters(e), np, w.c_dq.data(),
                     w.c_dqd.data(), w.c_dqdd.data(), w.c_dinp.data(), w.c_dp.data(), out.data(), w.c_dout.data());
-          std::fill(dout.begin(), dout.end(), 0.0);
-          for (int c = 0; c < nl; ++c)
-            std::copy_n(w.c_dout.data() + static_cast<std::size_t>(c) * ns, ns,
-                        dout.data() + static_cast<std::size_t>(w.live[c]) * ns);
+          w.plan.scatter(w.c_dout.data(), ns, ns, dout.data(), ns);
         }
         if (group == 0) kept.assign(kinematic_point_, dq, dqd, dp, dout);
       }
@@ -222,28 +224,6 @@ class Multibody : public Block {
 
  private:
   static bool same(const Matrix& a, const Matrix& b) { return a.rows() == b.rows() && a.cols() == b.cols() && a == b; }
-  // The directions (columns below nd) in which any of the matrices has a nonzero entry.
-  static void live_columns(std::initializer_list<const Matrix*> matrices, int nd, std::vector<int>& live) {
-    live.clear();
-    for (int d = 0; d < nd; ++d)
-      for (const Matrix* m : matrices)
-        if (!m->col(d).isZero(0.0)) {
-          live.push_back(d);
-          break;
-        }
-  }
-  // Columns `live` of a, side by side (one zero column when there are none).
-  static void gather(const Matrix& a, const std::vector<int>& live, Matrix& b) {
-    b.resize(a.rows(), std::max<Eigen::Index>(1, live.size()));
-    if (live.empty()) b.setZero();
-    for (std::size_t c = 0; c < live.size(); ++c) b.col(c) = a.col(live[c]);
-  }
-  // The inverse: an rows x nd matrix with b's columns at `live` and zeros elsewhere.
-  static void scatter(const Matrix& b, const std::vector<int>& live, int rows, int nd, Matrix& a) {
-    a.setZero(rows, std::max(nd, 1));
-    for (std::size_t c = 0; c < live.size(); ++c) a.col(live[c]) = b.col(c);
-  }
-
   // Whether this call sets the group's sensor ports (0: positions and velocities, 1: reads
   // qdd): the ports of a group read the same inputs, so one port answers for all.
   bool sensor_group_ready(const Eval& e, int group) const {
@@ -382,18 +362,17 @@ class Multibody : public Block {
       // reach the car) have zero tangents: the partitioning and the generated tangents run on
       // the others only.
       Work& w = work_;
-      live_columns({&du, &dud, &driven, &dp}, nd, w.live);
-      const int nl = static_cast<int>(w.live.size());
-      if (nl == nd) {
+      w.plan.build({&du, &dud, &driven, &dp}, nd);
+      if (w.plan.whole()) {
         reduced_.tangent_kinematics(r, in.data(), parameters(e), nd, du.data(), dud.data(), dinp.data(), dp.data(),
                                     dq, dqd);
       } else {
-        gather(du, w.live, w.c_du), gather(dud, w.live, w.c_dud), gather(dinp, w.live, w.c_dinp);
-        gather(dp, w.live, w.c_dp);
-        if (nl > 0)
-          reduced_.tangent_kinematics(r, in.data(), parameters(e), nl, w.c_du.data(), w.c_dud.data(), w.c_dinp.data(),
-                                      w.c_dp.data(), w.c_dq, w.c_dqd);
-        scatter(w.c_dq, w.live, g_.n, nd, dq), scatter(w.c_dqd, w.live, g_.n, nd, dqd);
+        w.plan.gather(du, 0, w.c_du), w.plan.gather(dud, 1, w.c_dud), w.plan.gather(dinp, -1, w.c_dinp);
+        w.plan.gather(dp, 3, w.c_dp);
+        if (w.plan.passes() > 0)
+          reduced_.tangent_kinematics(r, in.data(), parameters(e), w.plan.passes(), w.c_du.data(), w.c_dud.data(),
+                                      w.c_dinp.data(), w.c_dp.data(), w.c_dq, w.c_dqd);
+        w.plan.scatter(w.c_dq, g_.n, dq), w.plan.scatter(w.c_dqd, g_.n, dqd);
       }
       kinematic_tangent_.assign(kinematic_point_, du, dud, driven, dp, dq, dqd, nullptr);
     }
@@ -401,18 +380,18 @@ class Multibody : public Block {
       dqdd.setZero(g_.n, std::max(nd, 1));  // not read: no acceleration output in this call
       return;
     }
+    // Directions seeded on one load entry only (dq = dqd = 0 for them) share a pass per entry.
     Work& w = work_;
-    live_columns({&du, &dud, &dinp, &dp}, nd, w.live);
-    const int nl = static_cast<int>(w.live.size());
-    if (nl == nd) {
+    w.plan.build({&du, &dud, &dinp, &dp}, nd, 2, g_.load_inputs);
+    if (w.plan.whole()) {
       reduced_.tangent_dynamics(r, in.data(), parameters(e), nd, dinp.data(), dp.data(), dq, dqd, dqdd);
     } else {
-      gather(dinp, w.live, w.c_dinp), gather(dp, w.live, w.c_dp), gather(dq, w.live, w.c_dq);
-      gather(dqd, w.live, w.c_dqd);
-      if (nl > 0)
-        reduced_.tangent_dynamics(r, in.data(), parameters(e), nl, w.c_dinp.data(), w.c_dp.data(), w.c_dq, w.c_dqd,
-                                  w.c_dqdd);
-      scatter(w.c_dqdd, w.live, g_.n, nd, dqdd);
+      w.plan.gather(dinp, 2, w.c_dinp), w.plan.gather(dp, 3, w.c_dp), w.plan.gather(dq, -1, w.c_dq);
+      w.plan.gather(dqd, -1, w.c_dqd);
+      if (w.plan.passes() > 0)
+        reduced_.tangent_dynamics(r, in.data(), parameters(e), w.plan.passes(), w.c_dinp.data(), w.c_dp.data(),
+                                  w.c_dq, w.c_dqd, w.c_dqdd);
+      w.plan.scatter(w.c_dqdd, g_.n, dqdd);
     }
     full_tangent_.assign(point_, du, dud, dinp, dp, dq, dqd, &dqdd);
   }
@@ -468,8 +447,8 @@ class Multibody : public Block {
     Vector in, kinematic;
     Matrix du, dud, dinp, dp, driven, dq, dqd, dqdd;
     std::vector<double> out, dout;
-    // the directions with nonzero seeds, and the seeds and tangents in those directions only
-    std::vector<int> live;
+    // the passes a call's directions need (DirectionPlan), and the seeds and tangents of those
+    DirectionPlan plan;
     Matrix c_du, c_dud, c_dinp, c_dp, c_dq, c_dqd, c_dqdd;
     std::vector<double> c_dout;
   };

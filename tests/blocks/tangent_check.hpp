@@ -168,34 +168,49 @@ inline Values evaluate(const engine::Block& b, const Point& pt) {
   return out;
 }
 
-/// Tangents of the four functions, one direction per variable (states, inputs, parameters).
-inline Values tangents(const engine::Block& b, const Point& pt, int nd) {
-  const int nx = b.num_states(), nq = b.num_quadratures(), np = static_cast<int>(pt.p.size());
+/// Seeds of nd directions: sx[d*nx + i] for state i, su[k][d*width_k + i] for element i of
+/// input port k, sp[d*np + j] for parameter j.
+struct SeedSet {
+  std::vector<double> sx, sp;
+  std::vector<std::vector<double>> su;
+};
+
+/// One direction per variable (states, inputs, parameters), in that order.
+inline SeedSet unit_seeds(const engine::Block& b, const Point& pt, int nd) {
+  const int nx = b.num_states(), np = static_cast<int>(pt.p.size());
   int nu = 0;
   for (const auto& v : pt.u) nu += static_cast<int>(v.size());
-  std::vector<double> sx(static_cast<size_t>(std::max(nx, 1)) * nd, 0.0);
-  for (int i = 0; i < nx; ++i) sx[i * nx + i] = 1.0;
-  std::vector<std::vector<double>> su;
-  std::vector<engine::ConstDirView> su_view, su_poisoned;
-  std::vector<std::vector<double>> su_nan;
+  SeedSet seeds;
+  seeds.sx.assign(static_cast<size_t>(std::max(nx, 1)) * nd, 0.0);
+  for (int i = 0; i < nx; ++i) seeds.sx[i * nx + i] = 1.0;
   int off = nx;
   for (const auto& v : pt.u) {
     const int w = static_cast<int>(v.size());
-    su.emplace_back(static_cast<size_t>(w) * nd, 0.0);
-    for (int i = 0; i < w; ++i) su.back()[(off + i) * w + i] = 1.0;
-    su_nan.emplace_back(static_cast<size_t>(w) * nd, std::numeric_limits<double>::quiet_NaN());
+    seeds.su.emplace_back(static_cast<size_t>(w) * nd, 0.0);
+    for (int i = 0; i < w; ++i) seeds.su.back()[(off + i) * w + i] = 1.0;
     off += w;
   }
-  for (size_t k = 0; k < su.size(); ++k) {
-    su_view.push_back({su[k].data(), static_cast<int>(pt.u[k].size())});
+  seeds.sp.assign(static_cast<size_t>(std::max(np, 1)) * nd, 0.0);
+  for (int j = 0; j < np; ++j) seeds.sp[(nx + nu + j) * np + j] = 1.0;
+  return seeds;
+}
+
+/// Tangents of the four functions in the nd directions of `seeds`, as the engine asks for them.
+inline Values tangents(const engine::Block& b, const Point& pt, int nd, const SeedSet& seeds) {
+  const int nx = b.num_states(), nq = b.num_quadratures(), np = static_cast<int>(pt.p.size());
+  std::vector<engine::ConstDirView> su_view, su_poisoned;
+  std::vector<std::vector<double>> su_nan;
+  for (const auto& v : pt.u)
+    su_nan.emplace_back(static_cast<size_t>(v.size()) * nd, std::numeric_limits<double>::quiet_NaN());
+  for (size_t k = 0; k < seeds.su.size(); ++k) {
+    su_view.push_back({seeds.su[k].data(), static_cast<int>(pt.u[k].size())});
     su_poisoned.push_back({su_nan[k].data(), static_cast<int>(pt.u[k].size())});
   }
-  std::vector<double> sp(static_cast<size_t>(std::max(np, 1)) * nd, 0.0);
-  for (int j = 0; j < np; ++j) sp[(nx + nu + j) * np + j] = 1.0;
   engine::Seeds s;
   s.directions = nd;
-  s.x = nx ? engine::ConstDirView{sx.data(), nx} : engine::ConstDirView{};
-  s.p = np ? engine::ConstDirView{sp.data(), np} : engine::ConstDirView{};
+  s.x = nx ? engine::ConstDirView{seeds.sx.data(), nx} : engine::ConstDirView{};
+  s.p = np ? engine::ConstDirView{seeds.sp.data(), np} : engine::ConstDirView{};
+  int off = 0;
 
   std::vector<const double*> u;
   std::vector<std::vector<double>> poisoned;
@@ -246,6 +261,11 @@ inline Values tangents(const engine::Block& b, const Point& pt, int nd) {
     b.initial_state_tangent(e, s0, {out.x0.data(), nx});
   }
   return out;
+}
+
+/// Tangents of the four functions, one direction per variable (states, inputs, parameters).
+inline Values tangents(const engine::Block& b, const Point& pt, int nd) {
+  return tangents(b, pt, nd, unit_seeds(b, pt, nd));
 }
 
 /// Block::local_jacobian at the point (nx x nx, column-major), or empty when not provided.
