@@ -323,12 +323,11 @@ struct LaneSeed {
   b[j] = x.second();
 }
 
-// One direction (an odd last one): the same derivative code on plain doubles. A primal value
-// broadcast to Lanes enters by its first lane (no instruction: the register's low half).
+// One direction (an odd last one): the same derivative code on plain doubles, reading the
+// primal values as they are.
 struct One {
   double v;
-  One(double x) : v(x) {}            // NOLINT(google-explicit-constructor): constants
-  One(Lanes x) : v(x.first()) {}     // NOLINT(google-explicit-constructor): primal values
+  One(double x) : v(x) {}  // NOLINT(google-explicit-constructor): constants and primal values
 };
 [[maybe_unused]] inline One operator+(One x, One y) { return One(x.v + y.v); }
 [[maybe_unused]] inline One operator-(One x, One y) { return One(x.v - y.v); }
@@ -566,52 +565,59 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
     printer.print(o.value, body);
     body += ";  // " + one_line(o.name) + "\n";
   }
-  // The primal values the derivative part reads, broadcast to both lanes once before the loop:
-  // read in the loop as a pair from memory, not loaded and unpacked once per pass.
+  // Two directions per pass: the derivative part's arithmetic runs on pairs (Lanes, one SSE2
+  // register), so a direction costs about half the instructions. The primal values it reads
+  // are broadcast to both lanes once before the loop: read in the loop as a pair from memory,
+  // not loaded and unpacked once per pass. An odd last direction (a sensitivity pass has one)
+  // runs the same derivative code once more on plain doubles (One, OneSeed), reading the primal
+  // values as they are: with one direction, nothing is broadcast.
   const std::unordered_map<NodeId, std::string> lane_names = primal_values_read(tangent);
   std::vector<std::pair<NodeId, std::string>> sorted(lane_names.begin(), lane_names.end());
   std::sort(sorted.begin(), sorted.end());
-  for (const auto& [x, name] : sorted) {
-    body += "  const Lanes " + name + " = ";
-    printer.print(x, body);
-    body += ";\n";
-  }
   const Printer lane_printer(ctx, &lane_names);
-  // Two directions per pass: the derivative part's arithmetic runs on pairs (Lanes, one SSE2
-  // register), so a direction costs about half the instructions. An odd last direction runs the
-  // same code once more on plain doubles (One, OneSeed): a sensitivity pass has one direction.
   const std::string k = std::to_string(derivative_outputs);
-  std::string derivatives;  // the loop's body, for either lane type
-  write_assignments(tangent, lane_printer, tangent.primal_assignments(), tangent.size(), "    ", derivatives, "auto");
-  for (std::size_t j = 0; j < derivative_outputs; ++j) {
-    const Output& o = tangent.outputs()[primal_outputs + j];
-    derivatives += "    store_lanes(dout_a, dout_b, " + std::to_string(j) + ", ";
-    lane_printer.print(o.value, derivatives);
-    derivatives += ");  // " + one_line(o.name) + "\n";
-  }
+  // the derivative part for either lane type, at `indent`
+  auto derivative_part = [&](const Printer& p, const std::string& indent) {
+    std::string text;
+    write_assignments(tangent, p, tangent.primal_assignments(), tangent.size(), indent, text, "auto");
+    for (std::size_t j = 0; j < derivative_outputs; ++j) {
+      const Output& o = tangent.outputs()[primal_outputs + j];
+      text += indent + "store_lanes(dout_a, dout_b, " + std::to_string(j) + ", ";
+      p.print(o.value, text);
+      text += ");  // " + one_line(o.name) + "\n";
+    }
+    return text;
+  };
   // each seed array as the pass reads it: `dq{seed_q + d*33, seed_q + (d + 1)*33}` for a pair,
   // `dq{seed_q + d*33}` for one direction
-  auto declare_seeds = [&](const std::string& type, bool pair) {
+  auto declare_seeds = [&](const std::string& type, bool pair, const std::string& indent) {
     for (ArrayId a : seeded_arrays) {
       const Array& seed = ctx.array(ctx.seed_array(a));
       const std::string size = std::to_string(seed.elements.size()), from = "seed_" + ctx.array(a).name;
-      body += "    [[maybe_unused]] const " + type + " " + seed.name + "{" + from + " + d*" + size;
+      body += indent + "[[maybe_unused]] const " + type + " " + seed.name + "{" + from + " + d*" + size;
       if (pair) body += ", " + from + " + (d + 1)*" + size;
       body += "};\n";
     }
   };
-  body += "  for (int d = 0; d + 1 < nd; d += 2) {\n";
-  declare_seeds("LaneSeed", true);
-  body += "    double* const dout_a = dout + d*" + k + ";\n";
-  body += "    [[maybe_unused]] double* const dout_b = dout_a + " + k + ";\n";
-  body += derivatives;
+  body += "  if (nd >= 2) {\n";
+  for (const auto& [x, name] : sorted) {
+    body += "    const Lanes " + name + " = ";
+    printer.print(x, body);
+    body += ";\n";
+  }
+  body += "    for (int d = 0; d + 1 < nd; d += 2) {\n";
+  declare_seeds("LaneSeed", true, "      ");
+  body += "      double* const dout_a = dout + d*" + k + ";\n";
+  body += "      [[maybe_unused]] double* const dout_b = dout_a + " + k + ";\n";
+  body += derivative_part(lane_printer, "      ");
+  body += "    }\n";
   body += "  }\n";
   body += "  if (nd % 2 == 1) {\n";
   body += "    const int d = nd - 1;\n";
-  declare_seeds("OneSeed", false);
+  declare_seeds("OneSeed", false, "    ");
   body += "    double* const dout_a = dout + d*" + k + ";\n";
   body += "    [[maybe_unused]] constexpr decltype(nullptr) dout_b = nullptr;\n";
-  body += derivatives;
+  body += derivative_part(printer, "    ");
   body += "  }\n}\n";
   return EmittedFunction{options.function_name, wrapped_signature(signature) + ";\n", body, true};
 }
