@@ -31,17 +31,19 @@ class DirectionPlan {
     std::vector<char>& live = live_;
     live.assign(nd, 0);
     for (int d = 0; d < nd; ++d) {
+      // the first nonzero seed, then (only if it may be a shared one) whether there is another
       int count = 0, which = -1, row = -1, m = 0;
       double value = 0.0;
       for (const Matrix* a : matrices) {
         const double* col = a->data() + static_cast<Eigen::Index>(d) * a->rows();
-        for (Eigen::Index i = 0; i < a->rows() && count < 2; ++i)
+        for (Eigen::Index i = 0; i < a->rows(); ++i)
           if (col[i] != 0.0) {
-            ++count;
+            if (++count == 2) break;
             which = m, row = static_cast<int>(i), value = col[i];
+            if (m != shared || row >= shared_rows) break;
           }
+        if (count >= 2 || (count == 1 && (which != shared || row >= shared_rows))) break;
         ++m;
-        if (count >= 2) break;
       }
       live[d] = count > 0;
       if (count == 1 && which == shared && row < shared_rows) {
