@@ -21,7 +21,7 @@ class DirectionPlan {
   /// shared_rows share a pass with the others on the same row, when there are others.
   void build(std::initializer_list<const Matrix*> matrices, int nd, int shared = -1, int shared_rows = 0) {
     nd_ = nd;
-    shared_ = shared;
+    shared_ = shared >= 0 ? matrices.begin()[shared] : nullptr;
     passes_.clear();
     uses_.assign(nd, Use{});
     unit_row_.assign(nd, -1);
@@ -77,9 +77,10 @@ class DirectionPlan {
   /// Every direction a pass of its own, in order: the seeds serve as they are.
   bool whole() const { return whole_; }
 
-  /// The seeds of the passes from `a` (rows x nd), the planned matrix of index `which` (-1: a
-  /// matrix not planned on, whose shared passes are zero): b is rows x max(1, passes).
-  void gather(const Matrix& a, int which, Matrix& b) const {
+  /// The seeds of the passes from `a` (rows x nd): a shared pass has the unit seed in the
+  /// shared matrix (the very object given to build()) and zero in any other. b is
+  /// rows x max(1, passes).
+  void gather(const Matrix& a, Matrix& b) const {
     b.resize(a.rows(), std::max(1, passes()));
     if (passes_.empty()) b.setZero();
     for (int c = 0; c < passes(); ++c) {
@@ -88,7 +89,7 @@ class DirectionPlan {
         b.col(c) = a.col(pass.direction);
       } else {
         b.col(c).setZero();
-        if (which == shared_) b(pass.row, c) = 1.0;
+        if (&a == shared_) b(pass.row, c) = 1.0;
       }
     }
   }
@@ -126,7 +127,8 @@ class DirectionPlan {
     double scale = 0.0;
     bool copy = false;
   };
-  int nd_ = 0, shared_ = -1;
+  int nd_ = 0;
+  const Matrix* shared_ = nullptr;
   bool whole_ = true;
   std::vector<Pass> passes_;
   std::vector<Use> uses_;

@@ -179,10 +179,8 @@ class Multibody : public Block {
                   dqdd.data(), dinp.data(), dp.data(), out.data(), dout.data());
         } else {
           const int np = w.plan.passes();
-          const int at_inp = group == 0 ? 2 : 3, at_dp = group == 0 ? 3 : 4;
-          w.plan.gather(dq, 0, w.c_dq), w.plan.gather(dqd, 1, w.c_dqd);
-          w.plan.gather(dqdd, group == 0 ? -1 : 2, w.c_dqdd);
-          w.plan.gather(dinp, at_inp, w.c_dinp), w.plan.gather(dp, at_dp, w.c_dp);
+          w.plan.gather(dq, w.c_dq), w.plan.gather(dqd, w.c_dqd), w.plan.gather(dqdd, w.c_dqdd);
+          w.plan.gather(dinp, w.c_dinp), w.plan.gather(dp, w.c_dp);
           w.c_dout.resize(static_cast<std::size_t>(std::max(1, ns)) * std::max(1, np));
           if (np > 0)
             sensors(r.q.data(), r.qd.data(), r.qdd.data(), lam, w.in.data(), parameters(e), np, w.c_dq.data(),
@@ -367,8 +365,8 @@ class Multibody : public Block {
         reduced_.tangent_kinematics(r, in.data(), parameters(e), nd, du.data(), dud.data(), dinp.data(), dp.data(),
                                     dq, dqd);
       } else {
-        w.plan.gather(du, 0, w.c_du), w.plan.gather(dud, 1, w.c_dud), w.plan.gather(dinp, -1, w.c_dinp);
-        w.plan.gather(dp, 3, w.c_dp);
+        w.plan.gather(du, w.c_du), w.plan.gather(dud, w.c_dud), w.plan.gather(dinp, w.c_dinp);
+        w.plan.gather(dp, w.c_dp);
         if (w.plan.passes() > 0)
           reduced_.tangent_kinematics(r, in.data(), parameters(e), w.plan.passes(), w.c_du.data(), w.c_dud.data(),
                                       w.c_dinp.data(), w.c_dp.data(), w.c_dq, w.c_dqd);
@@ -386,8 +384,8 @@ class Multibody : public Block {
     if (w.plan.whole()) {
       reduced_.tangent_dynamics(r, in.data(), parameters(e), nd, dinp.data(), dp.data(), dq, dqd, dqdd);
     } else {
-      w.plan.gather(dinp, 2, w.c_dinp), w.plan.gather(dp, 3, w.c_dp), w.plan.gather(dq, -1, w.c_dq);
-      w.plan.gather(dqd, -1, w.c_dqd);
+      w.plan.gather(dinp, w.c_dinp), w.plan.gather(dp, w.c_dp), w.plan.gather(dq, w.c_dq);
+      w.plan.gather(dqd, w.c_dqd);
       if (w.plan.passes() > 0)
         reduced_.tangent_dynamics(r, in.data(), parameters(e), w.plan.passes(), w.c_dinp.data(), w.c_dp.data(),
                                   w.c_dq, w.c_dqd, w.c_dqdd);

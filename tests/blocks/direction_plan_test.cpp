@@ -29,8 +29,8 @@ TEST(DirectionPlan, DirectionsOnOneEntryShareAPassAndTheOthersKeepTheirs) {
   EXPECT_FALSE(plan.whole());
   ASSERT_EQ(plan.passes(), 3);  // row 1's unit seed, direction 3, direction 4
   Matrix ga, gb;
-  plan.gather(a, 0, ga);
-  plan.gather(b, 1, gb);
+  plan.gather(a, ga);
+  plan.gather(b, gb);
   EXPECT_EQ(gb.col(0), Eigen::Vector3d(0.0, 1.0, 0.0));
   EXPECT_EQ(ga.col(0), Eigen::Vector2d::Zero());
   EXPECT_EQ(ga.col(1), a.col(3));

@@ -210,7 +210,6 @@ inline Values tangents(const engine::Block& b, const Point& pt, int nd, const Se
   s.directions = nd;
   s.x = nx ? engine::ConstDirView{seeds.sx.data(), nx} : engine::ConstDirView{};
   s.p = np ? engine::ConstDirView{seeds.sp.data(), np} : engine::ConstDirView{};
-  int off = 0;
 
   std::vector<const double*> u;
   std::vector<std::vector<double>> poisoned;
@@ -231,7 +230,7 @@ inline Values tangents(const engine::Block& b, const Point& pt, int nd, const Se
   for (const auto& port : b.outputs()) ny += port.width;
   out.y.assign(static_cast<size_t>(ny) * nd, std::numeric_limits<double>::quiet_NaN());
   std::vector<engine::DirView> dy;
-  off = 0;
+  int off = 0;
   for (const auto& port : b.outputs()) { dy.push_back({out.y.data() + off, ny}); off += port.width; }
   if (any_state_only_output(b)) {
     e.inputs_ready = false;
