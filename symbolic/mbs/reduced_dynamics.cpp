@@ -65,6 +65,26 @@ ReducedDynamics::ReducedDynamics(const GeneratedModel& model) : model_(model), p
     }
     s_start_.push_back(static_cast<int>(s_col_.size()));
   }
+  if (model.mass_matrix) {
+    const int k = nu + (model.m > 0 ? 1 : 0);
+    std::vector<std::vector<std::pair<int, int>>> terms(static_cast<std::size_t>(n) * k);
+    for (int e = 0; e < model.mass_entries; ++e) {
+      const int i = model.mass_rows[e], j = model.mass_cols[e];
+      for (int t = s_start_[j]; t < s_start_[j + 1]; ++t) terms[static_cast<std::size_t>(i) * k + s_col_[t]].emplace_back(e, t);
+      if (i != j)
+        for (int t = s_start_[i]; t < s_start_[i + 1]; ++t) terms[static_cast<std::size_t>(j) * k + s_col_[t]].emplace_back(e, t);
+    }
+    mb_start_.assign(1, 0);
+    for (std::size_t o = 0; o < terms.size(); ++o) {
+      if (terms[o].empty()) continue;
+      mb_place_.push_back(static_cast<int>(o));
+      for (const auto& [e, t] : terms[o]) {
+        mb_mass_.push_back(e);
+        mb_s_.push_back(t);
+      }
+      mb_start_.push_back(static_cast<int>(mb_mass_.size()));
+    }
+  }
 }
 
 void ReducedDynamics::solve(const double* u, const double* ud, const double* inputs, const double* p,
@@ -189,19 +209,16 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
       for (int t = s_start_[j]; t < s_start_[j + 1]; ++t) w.s_val[t] = s_col_[t] < nu ? r.B(a, s_col_[t]) : w.beta[a];
     }
     r.MB.setZero();
-    double* mb = r.MB.data();  // row-major: entry (i, c) at i * k + c
-    const int* start = s_start_.data();
-    const int* col = s_col_.data();
+    double* __restrict mb = r.MB.data();
+    const double* mass = w.mass.data();
     const double* val = w.s_val.data();
-    for (int e = 0; e < model_.mass_entries; ++e) {
-      const int i = model_.mass_rows[e], j = model_.mass_cols[e];
-      const double v = w.mass[e];
-      double* row_i = mb + static_cast<Eigen::Index>(i) * k;
-      for (int t = start[j]; t < start[j + 1]; ++t) row_i[col[t]] += v * val[t];
-      if (i != j) {
-        double* row_j = mb + static_cast<Eigen::Index>(j) * k;
-        for (int t = start[i]; t < start[i + 1]; ++t) row_j[col[t]] += v * val[t];
-      }
+    const int* start = mb_start_.data();
+    const int* at_mass = mb_mass_.data();
+    const int* at_s = mb_s_.data();
+    for (std::size_t o = 0; o < mb_place_.size(); ++o) {
+      double sum = 0.0;
+      for (int t = start[o]; t < start[o + 1]; ++t) sum += mass[at_mass[t]] * val[at_s[t]];
+      mb[mb_place_[o]] = sum;
     }
   } else {
     // the inertial pass seeded on [B beta] (nu + 1 directions; M itself, n directions, is never
@@ -235,8 +252,15 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
     definite = r.reduced.compute(Eigen::Map<const Matrix>(r.MBf.data(), nf, nf));
   } else {
     w.reduced.setZero(nu, nu);  // B^T M_ff B over B's structure, column by column
-    for (int a = 0; a < nf; ++a)
-      for (int c : b_cols_[a]) w.reduced.col(c) += r.B(a, c) * r.MBf.row(a).transpose();
+    double* __restrict reduced = w.reduced.data();
+    for (int a = 0; a < nf; ++a) {
+      const double* mbf = r.MBf.data() + static_cast<Eigen::Index>(a) * nu;
+      const double* b = r.B.data() + static_cast<Eigen::Index>(a) * nu;
+      for (int c : b_cols_[a]) {
+        double* column = reduced + static_cast<Eigen::Index>(c) * nu;
+        for (int i = 0; i < nu; ++i) column[i] += b[c] * mbf[i];
+      }
+    }
     definite = r.reduced.compute(w.reduced);
   }
   if (!definite)

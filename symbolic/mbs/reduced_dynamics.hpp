@@ -119,6 +119,11 @@ class ReducedDynamics {
   // [B beta] by rows of q: row j's entries s_start_[j] .. s_start_[j + 1] - 1, at columns s_col_
   // (nu: beta); free row of coordinate j (-1: driven).
   std::vector<int> s_start_, s_col_, free_row_of_;
+  // M [B beta] as gathered sums: entry mb_place_[o] (row-major, i * k + c) of the product is
+  // the sum over p in mb_start_[o] .. mb_start_[o + 1] - 1 of mass[mb_mass_[p]] * s_val[mb_s_[p]],
+  // the products of M's structurally nonzero entries (both triangles) and [B beta]'s, in the
+  // order a scatter over M's entries would add them. Entries with no product stay zero.
+  std::vector<int> mb_place_, mb_start_, mb_mass_, mb_s_;
   const GeneratedModel& model_;
   std::vector<int> u_, v_, f_, d_;
   std::vector<double> pad_;  // one zero for arrays of size zero
