@@ -21,6 +21,7 @@
 
 #include "engine/cpu_clock.hpp"
 #include "engine/dense_lu_solver.hpp"
+#include "engine/sundials_kernels.hpp"
 #include "engine/errors.hpp"
 #include "engine/jacobian_colouring.hpp"
 #include "engine/timeline.hpp"
@@ -179,6 +180,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   check(SUNContext_Create(nullptr, &S.ctx), "SUNContext_Create");
   S.y = N_VNew_Serial(n_cv, S.ctx);
   N_VEnableFusedOps_Serial(S.y, SUNTRUE);  // fewer passes over the sensitivity vectors
+  use_compiled_vector_kernels(S.y);         // before CVodeInit: CVODES clones its vectors from y
   N_VConst(0.0, S.y);
   ev.set_segment_start(t0);
   ev.initial_state(t0, NV_DATA_S(S.y));
@@ -203,6 +205,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   check(CVodeSetNonlinConvCoef(S.mem, d.solver.newton_coefficient), "CVodeSetNonlinConvCoef");
   if (bdf) {
     S.A = SUNDenseMatrix(n_cv, n_cv, S.ctx);
+    use_compiled_matrix_kernels(S.A);
     S.LS = make_dense_lu_solver(S.ctx, n_cv);
     check(CVodeSetLinearSolver(S.mem, S.LS, S.A), "CVodeSetLinearSolver");
     check(CVodeSetJacFn(S.mem, jacobian), "CVodeSetJacFn");
