@@ -4,6 +4,11 @@
 // main job; solved by plain column-oriented substitutions (Eigen's panelled triangular solves
 // are slow at this size). A SUNDIALS linear solver of the direct type on a dense SUNMatrix, so
 // CVODES uses it like SUNLinSol_Dense.
+//
+// Rows of the form x_i + c x_j = b_i (a unit diagonal and one other entry: in I - gamma J, a
+// state whose derivative is another state, the car's positions) are substituted out before the
+// factorisation, x_i = b_i - c x_j, so only the other rows are factored: 38 of the main job's 52
+// states, a third of the factorisation's work and a quarter of each solve's.
 #pragma once
 
 #include <sundials/sundials_context.h>
