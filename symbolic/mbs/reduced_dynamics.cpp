@@ -256,9 +256,9 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
     for (int a = 0; a < nf; ++a) {
       const double* mbf = r.MBf.data() + static_cast<Eigen::Index>(a) * nu;
       const double* b = r.B.data() + static_cast<Eigen::Index>(a) * nu;
-      for (int c : b_cols_[a]) {
-        double* column = reduced + static_cast<Eigen::Index>(c) * nu;
-        for (int i = 0; i < nu; ++i) column[i] += b[c] * mbf[i];
+      for (int col : b_cols_[a]) {
+        double* column = reduced + static_cast<Eigen::Index>(col) * nu;
+        for (int i = 0; i < nu; ++i) column[i] += b[col] * mbf[i];
       }
     }
     definite = r.reduced.compute(w.reduced);
