@@ -1,14 +1,9 @@
 // The Newton iteration's linear solver for CVODES: the dense matrix SUNDIALS forms (I - gamma J)
-// factored by Eigen's partial-pivoting LU (blocked and vectorised) instead of SUNDIALS' own
-// column-by-column GETRF/GETRS, which on the sedan's 52 states took about a seventh of the
-// main job; solved by plain column-oriented substitutions (Eigen's panelled triangular solves
-// are slow at this size). A SUNDIALS linear solver of the direct type on a dense SUNMatrix, so
-// CVODES uses it like SUNLinSol_Dense.
-//
-// Rows of the form x_i + c x_j = b_i (a unit diagonal and one other entry: in I - gamma J, a
-// state whose derivative is another state, the car's positions) are substituted out before the
-// factorisation, x_i = b_i - c x_j, so only the other rows are factored: 38 of the main job's 52
-// states, a third of the factorisation's work and a quarter of each solve's.
+// factored by NewtonLU (engine/newton_lu.hpp: the rows x_i + c x_j = b_i substituted out, the
+// rest by Eigen's partial-pivoting LU) instead of SUNDIALS' own column-by-column GETRF/GETRS,
+// which on the sedan's 52 states took about a seventh of the main job. A SUNDIALS linear solver
+// of the direct type on a dense SUNMatrix, so CVODES uses it like SUNLinSol_Dense; a zero pivot
+// is a recoverable failure naming its column, as SUNLinSol_Dense reports it.
 #pragma once
 
 #include <sundials/sundials_context.h>

@@ -8,6 +8,7 @@
 #include "engine/cpu_clock.hpp"
 #include "engine/errors.hpp"
 #include "engine/jacobian_colouring.hpp"
+#include "engine/newton_lu.hpp"
 #include "engine/recorder.hpp"
 #include "engine/timeline.hpp"
 #include "engine/tolerances.hpp"
@@ -220,14 +221,20 @@ class Ros2Stepper {
   }
 
   void factor(double h) {
-    if (nx_ > 0) lu_.compute(identity_ - kGamma * h * w_);
+    if (nx_ > 0) {
+      newton_matrix_ = identity_ - kGamma * h * w_;
+      lu_.factor(newton_matrix_.data(), nx_);  // a zero pivot shows as a non-finite stage
+    }
     factored_h_ = h;
   }
 
-  /// out = (I - gamma h W)^-1 rhs (nothing to solve without states).
+  /// out = (I - gamma h W)^-1 rhs, column by column (nothing to solve without states).
   template <class Rhs, class Out>
   void solve(const Rhs& rhs, Out&& out) const {
-    if (nx_ > 0) out = lu_.solve(rhs);
+    if (nx_ == 0) return;
+    columns_ = rhs;
+    for (Eigen::Index c = 0; c < columns_.cols(); ++c) lu_.solve(columns_.col(c).data(), columns_.col(c).data());
+    out = columns_;
   }
 
   /// f(t, y) and g(t, y) and, with sensitivities, their tangents for the state seeds dy.
@@ -260,7 +267,9 @@ class Ros2Stepper {
   bool fixed_;
   Matrix w_, identity_;
   JacobianColouring colouring_;
-  Eigen::PartialPivLU<Matrix> lu_;
+  Matrix newton_matrix_;
+  NewtonLU lu_;
+  mutable Matrix columns_;         ///< solve()'s right-hand sides, solved in place
   double factored_h_ = -1.0;
   int age_ = 0;                    ///< steps taken since W was evaluated
   double last_estimate_ = 0.0;     ///< the last accepted step's error estimate

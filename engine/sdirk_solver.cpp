@@ -8,6 +8,7 @@
 
 #include "engine/cpu_clock.hpp"
 #include "engine/errors.hpp"
+#include "engine/newton_lu.hpp"
 #include "engine/jacobian_colouring.hpp"
 #include "engine/timeline.hpp"
 #include "engine/recorder.hpp"
@@ -57,7 +58,8 @@ class Stepper {
     return has_local_;
   }
   void factor(double hg) {
-    lu_.compute(identity_ - hg * jac_);
+    newton_matrix_ = identity_ - hg * jac_;
+    lu_.factor(newton_matrix_.data(), nx_);  // a zero pivot shows as a non-finite iterate
     factored_hg_ = hg;
   }
 
@@ -96,7 +98,8 @@ class Stepper {
         throw StageFailure{t, e.what()};  // an iterate off the solution: not the solution's failure
       }
       const Vector residual = y - hg * fy - rhs;
-      const Vector delta = lu_.solve(residual);
+      Vector delta = residual;
+      lu_.solve(delta.data(), delta.data());
       y -= delta;
       ++stats_.nonlinear_iterations;
       const double size = delta.cwiseAbs().maxCoeff();
@@ -132,7 +135,8 @@ class Stepper {
     evaluate(t, [&] {
       ev_.tangents(t, y.data(), ns_, {}, true, {fp.data(), nx_}, {nq_ ? qp.data() : nullptr, nq_});
     });
-    const Matrix dy = lu_.solve(rhs + hg * fp);
+    Matrix dy = rhs + hg * fp;
+    for (Eigen::Index c = 0; c < dy.cols(); ++c) lu_.solve(dy.col(c).data(), dy.col(c).data());
     dk.resize(nx_, ns_);
     dq.resize(std::max(nq_, 1), ns_);
     dq.setZero();
@@ -159,7 +163,8 @@ class Stepper {
   RunStats& stats_;
   Matrix jac_, identity_;
   JacobianColouring colouring_;
-  Eigen::PartialPivLU<Matrix> lu_;
+  Matrix newton_matrix_;
+  NewtonLU lu_;
   double factored_hg_ = -1.0;
   bool has_local_ = true;  ///< some block provides a local Jacobian (until found otherwise)
 };
