@@ -6,13 +6,14 @@ namespace dydp::engine {
 
 // The substitutable rows of column-major a: a unit diagonal and exactly one other nonzero, in a
 // column whose row is not of that form itself (a chain x_a + c x_b, x_b + c' x_c keeps both).
-void NewtonLU::find_substituted_rows(const double* a) {
-  const Eigen::Index n = n_;
+void NewtonLU::find_substituted_rows(const double* a, int size) {
+  const Eigen::Index n = size;
   substituted_.clear();
   partner_.clear();
   coefficient_.clear();
   kept_.clear();
-  std::vector<int> other(static_cast<std::size_t>(n), -1);  // -1 none yet, -2 more than one
+  std::vector<int>& other = other_;
+  other.assign(static_cast<std::size_t>(n), -1);  // -1 none yet, -2 more than one
   for (Eigen::Index j = 0; j < n; ++j) {
     const double* column = a + j * n;
     for (Eigen::Index i = 0; i < n; ++i) {
@@ -20,7 +21,8 @@ void NewtonLU::find_substituted_rows(const double* a) {
       other[i] = other[i] == -1 ? static_cast<int>(j) : -2;
     }
   }
-  std::vector<char> candidate(static_cast<std::size_t>(n), 0);
+  std::vector<char>& candidate = candidate_;
+  candidate.assign(static_cast<std::size_t>(n), 0);
   for (Eigen::Index i = 0; i < n; ++i) candidate[i] = other[i] >= 0 && a[i * n + i] == 1.0;
   place_.assign(static_cast<std::size_t>(n), -1);
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -36,8 +38,7 @@ void NewtonLU::find_substituted_rows(const double* a) {
 }
 
 bool NewtonLU::factor(const double* a, int n) {
-  n_ = n;
-  find_substituted_rows(a);
+  find_substituted_rows(a, n);
   const auto m = static_cast<Eigen::Index>(kept_.size());
   const auto ne = static_cast<Eigen::Index>(substituted_.size());
   // a(kept, kept) with x_i = b_i - c_i x_{p_i} substituted: column p_i gains -a(kept, i) c_i

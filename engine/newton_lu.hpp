@@ -21,17 +21,16 @@ class NewtonLU {
   // x = A^-1 b for the last factored A; x may be b.
   void solve(const double* b, double* x) const;
   int failed_column() const { return failed_column_; }
-  int size() const { return n_; }
-  // Rows and columns factored (the others substituted), and the storage held, in doubles.
-  int factored() const { return static_cast<int>(kept_.size()); }
+  // The storage held (the factored rows only: the substituted ones are not factored).
   long real_words() const;
   long integer_words() const;
 
  private:
-  void find_substituted_rows(const double* a);
+  void find_substituted_rows(const double* a, int n);
 
-  int n_ = 0;
   int failed_column_ = -1;
+  std::vector<int> other_;      // scratch of find_substituted_rows: a row's one off-diagonal column
+  std::vector<char> candidate_;
   std::vector<int> substituted_, partner_, kept_;  // substituted_[e] = i, partner_[e] = j
   std::vector<double> coefficient_;                // c
   std::vector<int> place_;                         // row of a -> place among kept_ (-1: substituted)

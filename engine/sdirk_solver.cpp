@@ -97,8 +97,7 @@ class Stepper {
       } catch (const SolverError& e) {
         throw StageFailure{t, e.what()};  // an iterate off the solution: not the solution's failure
       }
-      const Vector residual = y - hg * fy - rhs;
-      Vector delta = residual;
+      Vector delta = y - hg * fy - rhs;  // the residual, solved in place
       lu_.solve(delta.data(), delta.data());
       y -= delta;
       ++stats_.nonlinear_iterations;

@@ -14,14 +14,32 @@
 
 namespace {
 
-struct Fixture {
+// The solver on matrix A with right-hand side b: SUNDIALS' matrix and vectors, freed at the end.
+struct System {
   SUNContext ctx = nullptr;
-  Fixture() { SUNContext_Create(nullptr, &ctx); }
-  ~Fixture() { SUNContext_Free(&ctx); }
+  SUNMatrix M = nullptr;
+  N_Vector x = nullptr, rhs = nullptr;
+  SUNLinearSolver S = nullptr;
+  System(const Eigen::MatrixXd& A, const Eigen::VectorXd& b) {
+    const auto n = static_cast<int>(A.rows());
+    SUNContext_Create(nullptr, &ctx);
+    M = SUNDenseMatrix(n, n, ctx);
+    Eigen::Map<Eigen::MatrixXd>(SM_DATA_D(M), n, n) = A;
+    x = N_VNew_Serial(n, ctx);
+    rhs = N_VNew_Serial(n, ctx);
+    Eigen::Map<Eigen::VectorXd>(NV_DATA_S(rhs), n) = b;
+    S = dydp::engine::make_dense_lu_solver(ctx, n);
+  }
+  ~System() {
+    SUNLinSolFree(S);
+    N_VDestroy(x);
+    N_VDestroy(rhs);
+    SUNMatDestroy(M);
+    SUNContext_Free(&ctx);
+  }
 };
 
 TEST(DenseLuSolver, SolvesLikeAnIndependentFactorisation) {
-  Fixture f;
   const int n = 52;
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -32,11 +50,10 @@ TEST(DenseLuSolver, SolvesLikeAnIndependentFactorisation) {
   Eigen::VectorXd b(n);
   for (int i = 0; i < n; ++i) b[i] = u(rng);
 
-  SUNMatrix M = SUNDenseMatrix(n, n, f.ctx);
-  Eigen::Map<Eigen::MatrixXd>(SM_DATA_D(M), n, n) = A;
-  N_Vector x = N_VNew_Serial(n, f.ctx), rhs = N_VNew_Serial(n, f.ctx);
-  Eigen::Map<Eigen::VectorXd>(NV_DATA_S(rhs), n) = b;
-  SUNLinearSolver S = dydp::engine::make_dense_lu_solver(f.ctx, n);
+  System sys(A, b);
+  SUNMatrix M = sys.M;
+  N_Vector x = sys.x, rhs = sys.rhs;
+  SUNLinearSolver S = sys.S;
   EXPECT_EQ(SUNLinSolGetType(S), SUNLINEARSOLVER_DIRECT);
   ASSERT_EQ(SUNLinSolInitialize(S), SUNLS_SUCCESS);
   ASSERT_EQ(SUNLinSolSetup(S, M), SUNLS_SUCCESS);
@@ -61,10 +78,6 @@ TEST(DenseLuSolver, SolvesLikeAnIndependentFactorisation) {
   EXPECT_EQ(SUNLinSolSetup(S, M), SUNLS_LUFACT_FAIL);
   EXPECT_GT(SUNLinSolLastFlag(S), 0);
   EXPECT_GT(SUNLS_LUFACT_FAIL, 0) << "a positive flag is recoverable for CVODES";
-  SUNLinSolFree(S);
-  N_VDestroy(x);
-  N_VDestroy(rhs);
-  SUNMatDestroy(M);
 }
 
 // The Newton matrix of a second-order system, I - gamma J with J = [0 I; K C] over positions and
@@ -74,7 +87,6 @@ TEST(DenseLuSolver, SolvesLikeAnIndependentFactorisation) {
 // partner has it too (a chain x_a - g x_b, x_b - g x_c) are kept; a singular kept system is
 // reported at a column of the whole matrix.
 TEST(DenseLuSolver, SubstitutesRowsOfTheFormXiPlusCXj) {
-  Fixture f;
   const int positions = 6, first_order = 5, n = 2 * positions + first_order + 2;
   const double gamma = 0.013;
   std::mt19937 rng(5);
@@ -89,11 +101,10 @@ TEST(DenseLuSolver, SubstitutesRowsOfTheFormXiPlusCXj) {
   Eigen::VectorXd b(n);
   for (int i = 0; i < n; ++i) b[i] = u(rng);
 
-  SUNMatrix M = SUNDenseMatrix(n, n, f.ctx);
-  Eigen::Map<Eigen::MatrixXd>(SM_DATA_D(M), n, n) = A;
-  N_Vector x = N_VNew_Serial(n, f.ctx), rhs = N_VNew_Serial(n, f.ctx);
-  Eigen::Map<Eigen::VectorXd>(NV_DATA_S(rhs), n) = b;
-  SUNLinearSolver S = dydp::engine::make_dense_lu_solver(f.ctx, n);
+  System sys(A, b);
+  SUNMatrix M = sys.M;
+  N_Vector x = sys.x, rhs = sys.rhs;
+  SUNLinearSolver S = sys.S;
   ASSERT_EQ(SUNLinSolInitialize(S), SUNLS_SUCCESS);
   ASSERT_EQ(SUNLinSolSetup(S, M), SUNLS_SUCCESS);
   long real_words = 0, integer_words = 0;
@@ -119,10 +130,6 @@ TEST(DenseLuSolver, SubstitutesRowsOfTheFormXiPlusCXj) {
   EXPECT_EQ(SUNLinSolSetup(S, M), SUNLS_LUFACT_FAIL);
   EXPECT_GT(SUNLinSolLastFlag(S), 0);
   EXPECT_LE(SUNLinSolLastFlag(S), n);
-  SUNLinSolFree(S);
-  N_VDestroy(x);
-  N_VDestroy(rhs);
-  SUNMatDestroy(M);
 }
 
 }  // namespace
