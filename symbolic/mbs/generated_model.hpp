@@ -15,6 +15,12 @@ using GeneratedTangent = void (*)(const double* q, const double* qd, const doubl
                                   const double* inp, const double* p, int nd, const double* seed_q,
                                   const double* seed_qd, const double* seed_qdd, const double* seed_inp,
                                   const double* seed_p, double* out, double* dout);
+// Tangent seeded on qd, qdd, inp and p, not on q: the derivatives for seeds with dq = 0 (a
+// direction that moves no coordinate), arrays laid out as in GeneratedTangent.
+using GeneratedVelocityTangent = void (*)(const double* q, const double* qd, const double* qdd, const double* lam,
+                                          const double* inp, const double* p, int nd, const double* seed_qd,
+                                          const double* seed_qdd, const double* seed_inp, const double* seed_p,
+                                          double* out, double* dout);
 // Tangent seeded on qdd only (the inertial pass: columns of M); it writes no primal outputs
 // (`out` is not touched).
 using GeneratedMassTangent = void (*)(const double* q, const double* qd, const double* qdd, const double* lam,
@@ -78,6 +84,9 @@ struct GeneratedModel {
   GeneratedTangent sensors_kinematic_tangent;
   GeneratedFunction sensors_acceleration;
   GeneratedTangent sensors_acceleration_tangent;
+  // residual_tangent for directions with dq = 0: it computes only what the velocities, loads,
+  // accelerations and parameters reach, none of the rotations' and positions' derivatives.
+  GeneratedVelocityTangent residual_velocity_tangent;
 };
 
 }  // namespace dydp::mbs

@@ -39,6 +39,39 @@ void ReducedCholesky::solve_in_place(double* x, Eigen::Index ld, Eigen::Index nr
   }
   const int n = n_;
   const double* __restrict l = l_.data();
+  if (nrhs >= 2) {
+    // Several right-hand sides: by rows of a row-major copy, each step an axpy over the
+    // right-hand sides (vectorised), in the order of operations of one column's substitution
+    // below, so the same results bit for bit.
+    const Eigen::Index m = nrhs;
+    rows_.resize(static_cast<std::size_t>(n * m));
+    double* __restrict t = rows_.data();
+    for (Eigen::Index c = 0; c < m; ++c)
+      for (int i = 0; i < n; ++i) t[i * m + c] = x[c * ld + i];
+    for (int i = 0; i < n; ++i) {  // L Y = B
+      double* __restrict ti = t + i * m;
+      for (int k = 0; k < i; ++k) {
+        const double f = l[i * n + k];
+        const double* __restrict tk = t + k * m;
+        for (Eigen::Index c = 0; c < m; ++c) ti[c] -= f * tk[c];
+      }
+      const double d = l[i * n + i];
+      for (Eigen::Index c = 0; c < m; ++c) ti[c] /= d;
+    }
+    for (int i = n - 1; i >= 0; --i) {  // L^T X = Y
+      double* __restrict ti = t + i * m;
+      for (int k = i + 1; k < n; ++k) {
+        const double f = l[k * n + i];
+        const double* __restrict tk = t + k * m;
+        for (Eigen::Index c = 0; c < m; ++c) ti[c] -= f * tk[c];
+      }
+      const double d = l[i * n + i];
+      for (Eigen::Index c = 0; c < m; ++c) ti[c] /= d;
+    }
+    for (Eigen::Index c = 0; c < m; ++c)
+      for (int i = 0; i < n; ++i) x[c * ld + i] = t[i * m + c];
+    return;
+  }
   for (Eigen::Index c = 0; c < nrhs; ++c) {
     double* __restrict y = x + c * ld;
     for (int i = 0; i < n; ++i) {  // L y = b

@@ -29,6 +29,7 @@ class ReducedCholesky {
   int n_ = 0;
   std::vector<double> l_;         // n x n row-major, lower triangle: the factor L (small sizes)
   Eigen::LLT<Matrix> large_;
+  mutable std::vector<double> rows_;  // several right-hand sides by rows (solve_in_place)
 };
 
 }  // namespace dydp::mbs

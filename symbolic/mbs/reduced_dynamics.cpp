@@ -56,6 +56,9 @@ ReducedDynamics::ReducedDynamics(const GeneratedModel& model) : model_(model), p
       for (int c : b_cols_[a]) dependent_entries_.push_back({f_[a], c, static_cast<int>(a) * nu + c});
     }
   }
+  for (int i = 0; i < model.m; ++i)
+    for (int j = 0; j < n; ++j)
+      if (kind[j] != 1 && model.jacobian_nonzero[i * n + j] != 0) seeded_entries_.push_back({i, j});
   s_start_.assign(1, 0);
   for (int j = 0; j < n; ++j) {
     const int a = free_row_of_[j];
@@ -323,22 +326,111 @@ void ReducedDynamics::tangent_kinematics(const Result& r, const double* inputs, 
     }
   }
   if (m > 0) {
-    // dh = Ju du + Jv dv + h_p dp = 0 (h's own tangent), then d(J qd) = 0 likewise for dv_dot.
-    // (lam is not read by these functions.)
+    // dh = Ju du + Jv dv + h_p dp = 0, then d(J qd) = 0 likewise for dv_dot. (lam is not read
+    // by these functions.) Without parameter seeds, dh is J dq over the seeded columns (J is
+    // at hand); otherwise h's own tangent.
     w.out.resize(2 * m);
     w.dout.resize(2 * m, nd);
     w.dh.resize(m, nd);
     w.dv.resize(m, nd);
-    model_.constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, nd, dq.data(),
-                               dqd.data(), w.dqdd_seed.data(), w.dinp.data(), w.dp.data(), w.out.data(), w.dh.data());
-    r.Jv.solve(w.dh.data(), m, nd, w.dv.data(), m);
-    for (int i = 0; i < m; ++i) dq.row(v_[i]) = -w.dv.row(i);
-    model_.velocity_constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, nd,
-                                        dq.data(), dqd.data(), w.dqdd_seed.data(), w.dinp.data(), w.dp.data(),
-                                        w.out.data(), w.dout.data());
+    const bool parameters_seeded = model_.parameters > 0 && !(w.dp.array() == 0.0).all();
+    // A direction with no seed on u, the driven joints or the parameters moves no coordinate
+    // (dh = 0, dv = 0) and has d(J qd) = J dqd: the solves and the generated tangents run on
+    // the others (when they come first, on those only).
+    split_directions(dq, parameters_seeded ? &w.dp : nullptr, nd, w.moving, w.still);
+    const int k = static_cast<int>(w.moving.size());
+    const int solved = k == 0 || w.moving.back() == k - 1 ? k : nd;
+    if (parameters_seeded) {
+      model_.constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, nd, dq.data(),
+                                 dqd.data(), w.dqdd_seed.data(), w.dinp.data(), w.dp.data(), w.out.data(),
+                                 w.dh.data());
+    } else {
+      for (int d = 0; d < solved; ++d) jacobian_times(r.J, dq.data() + d * n, w.dh.data() + d * m);
+    }
+    if (solved > 0) r.Jv.solve(w.dh.data(), m, solved, w.dv.data(), m);
+    for (int i = 0; i < m; ++i) dq.row(v_[i]).head(solved) = -w.dv.row(i).head(solved);  // (zero past them)
+    if (w.still.empty()) {
+      model_.velocity_constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, nd,
+                                          dq.data(), dqd.data(), w.dqdd_seed.data(), w.dinp.data(), w.dp.data(),
+                                          w.out.data(), w.dout.data());
+    } else {
+      if (k > 0 && w.moving.back() == k - 1) {  // the first k directions: the seeds as they are
+        model_.velocity_constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, k,
+                                            dq.data(), dqd.data(), w.dqdd_seed.data(), w.dinp.data(), w.dp.data(),
+                                            w.out.data(), w.dout.data());
+      } else if (k > 0) {
+        gather_columns(dq, w.moving, w.g_dq), gather_columns(dqd, w.moving, w.g_dqd);
+        gather_columns(w.dqdd_seed, w.moving, w.g_dqdd), gather_columns(w.dinp, w.moving, w.g_dinp);
+        gather_columns(w.dp, w.moving, w.g_dp);
+        w.g_dout.resize(2 * m, k);
+        model_.velocity_constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, k,
+                                            w.g_dq.data(), w.g_dqd.data(), w.g_dqdd.data(), w.g_dinp.data(),
+                                            w.g_dp.data(), w.out.data(), w.g_dout.data());
+        for (int c = 0; c < k; ++c) w.dout.col(w.moving[c]) = w.g_dout.col(c);
+      }
+      for (int d : w.still) jacobian_times(r.J, dqd.data() + d * n, w.dout.data() + d * 2 * m + m);
+    }
     r.Jv.solve(w.dout.data() + m, 2 * m, nd, w.dv.data(), m);
     for (int i = 0; i < m; ++i) dqd.row(v_[i]) = -w.dv.row(i);
   }
+}
+
+void ReducedDynamics::jacobian_times(const Matrix& J, const double* x, double* out) const {
+  for (int i = 0; i < model_.m; ++i) out[i] = 0.0;
+  for (const JacobianEntry& e : seeded_entries_) out[e.row] += J(e.row, e.col) * x[e.col];
+}
+
+void ReducedDynamics::split_directions(const Matrix& dq, const Matrix* dp, int nd, std::vector<int>& moving,
+                                       std::vector<int>& still) {
+  moving.clear();
+  still.clear();
+  for (int d = 0; d < nd; ++d) {
+    const bool moves = !(dq.col(d).array() == 0.0).all() || (dp && !(dp->col(d).array() == 0.0).all());
+    (moves ? moving : still).push_back(d);
+  }
+}
+
+void ReducedDynamics::gather_columns(const Matrix& a, const std::vector<int>& cols, Matrix& out) {
+  out.resize(a.rows(), static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t c = 0; c < cols.size(); ++c) out.col(static_cast<Eigen::Index>(c)) = a.col(cols[c]);
+}
+
+void ReducedDynamics::residual_tangent(const Result& r, const double* lam, const double* in, const double* p, int nd,
+                                       const Matrix& dq, const Matrix& dqd, const Matrix& dqdd) const {
+  Result::Work& w = r.work;
+  const int n = model_.n, rows = n + model_.m;
+  w.out.resize(rows);
+  w.dout.resize(rows, nd);
+  if (model_.residual_velocity_tangent) split_directions(dq, nullptr, nd, w.moving, w.still);
+  if (!model_.residual_velocity_tangent || w.still.empty()) {
+    model_.residual_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam, in, p, nd, dq.data(), dqd.data(),
+                            dqdd.data(), w.dinp.data(), w.dp.data(), w.out.data(), w.dout.data());
+    return;
+  }
+  // the moving directions' tangent, then the others' (dq = 0) from the velocity tangent, for
+  // seeds whose first k columns are the moving directions
+  const int k = static_cast<int>(w.moving.size());
+  auto run = [&](const double* sq, const double* sqd, const double* sqdd, const double* sinp, const double* sp,
+                 Eigen::Index ld_inp, Eigen::Index ld_p, double* dout) {
+    if (k > 0)
+      model_.residual_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam, in, p, k, sq, sqd, sqdd, sinp, sp,
+                              w.out.data(), dout);
+    model_.residual_velocity_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam, in, p, nd - k, sqd + k * n,
+                                     sqdd + k * n, sinp + k * ld_inp, sp + k * ld_p, w.out.data(),
+                                     dout + static_cast<Eigen::Index>(k) * rows);
+  };
+  if (k == 0 || w.moving.back() == k - 1) {  // the first k directions (moving holds them in order)
+    run(dq.data(), dqd.data(), dqdd.data(), w.dinp.data(), w.dp.data(), w.dinp.rows(), w.dp.rows(), w.dout.data());
+    return;
+  }
+  std::vector<int>& order = w.moving;  // moving, then still
+  order.insert(order.end(), w.still.begin(), w.still.end());
+  gather_columns(dq, order, w.g_dq), gather_columns(dqd, order, w.g_dqd), gather_columns(dqdd, order, w.g_dqdd);
+  gather_columns(w.dinp, order, w.g_dinp), gather_columns(w.dp, order, w.g_dp);
+  w.g_dout.resize(rows, nd);
+  run(w.g_dq.data(), w.g_dqd.data(), w.g_dqdd.data(), w.g_dinp.data(), w.g_dp.data(), w.g_dinp.rows(),
+      w.g_dp.rows(), w.g_dout.data());
+  for (int c = 0; c < nd; ++c) w.dout.col(order[c]) = w.g_dout.col(c);
 }
 
 void ReducedDynamics::tangent(const Result& r, const double* inputs, const double* p, int nd, const double* du,
@@ -364,10 +456,7 @@ void ReducedDynamics::dynamics_from_seeds(const Result& r, const double* inputs,
   Result::Work& w = r.work;
   const double* lam = m ? r.lam.data() : pad_.data();
   // dr = dM qdd + dc - dJ^T lam (qdd, lam frozen; driven dqdd seeded), da = dJ qdd + d(Jdot qd).
-  w.out.resize(n + m);
-  w.dout.resize(n + m, nd);
-  model_.residual_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam, in, p, nd, dq.data(), dqd.data(),
-                          dqdd.data(), w.dinp.data(), w.dp.data(), w.out.data(), w.dout.data());
+  residual_tangent(r, lam, in, p, nd, dq, dqd, dqdd);
   const int nf = static_cast<int>(f_.size()), nu = this->nu(), rows = n + m;
   w.dudd.resize(nu, nd);
   double* dudd = w.dudd.data();

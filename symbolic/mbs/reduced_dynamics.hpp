@@ -49,6 +49,10 @@ class ReducedDynamics {
       Vector beta, cf, Mbeta, fv, qddf;
       Matrix Ju, Bv, beta_v, reduced, MBv, mass_columns;
       Matrix dinp, dp, dqdd_seed, dout, dh, dv, dbeta_v, dudd;
+      // directions that move the coordinates (dq != 0) and those that do not, and their seeds
+      // gathered in that order when they are not already
+      std::vector<int> moving, still;
+      Matrix g_dq, g_dqd, g_dqdd, g_dinp, g_dp, g_dout;
     };
     mutable Work work;
   };
@@ -96,6 +100,18 @@ class ReducedDynamics {
   // joints' seeded accelerations.
   void dynamics_from_seeds(const Result& r, const double* inputs, const double* p, int nd, const Matrix& dq,
                            const Matrix& dqd, Matrix& dqdd) const;
+  // out (m) = J x over seeded_entries_ (x: n entries, zero in the dependent ones).
+  void jacobian_times(const Matrix& J, const double* x, double* out) const;
+  // The directions (columns) with a nonzero dq, or a nonzero dp when dp is given, and the others.
+  static void split_directions(const Matrix& dq, const Matrix* dp, int nd, std::vector<int>& moving,
+                               std::vector<int>& still);
+  // out = the columns `cols` of a, in that order.
+  static void gather_columns(const Matrix& a, const std::vector<int>& cols, Matrix& out);
+  // The residual's tangent (dr, da) into r.work.dout for the seeds dq, dqd, dqdd and
+  // r.work.dinp, dp: the directions with dq = 0 through the model's velocity tangent, which
+  // skips every derivative of the rotations and positions.
+  void residual_tangent(const Result& r, const double* lam, const double* in, const double* p, int nd,
+                        const Matrix& dq, const Matrix& dqd, const Matrix& dqdd) const;
   // Row a of the free coordinates: its place among u (>= 0), or -1 - its place among v.
   std::vector<int> free_place_;
   // The structure of B = [I; -Jv^-1 Ju] over the free coordinates: the u columns row a can be
@@ -124,6 +140,13 @@ class ReducedDynamics {
   // the products of M's structurally nonzero entries (both triangles) and [B beta]'s, in the
   // order a scatter over M's entries would add them. Entries with no product stay zero.
   std::vector<int> mb_place_, mb_start_, mb_mass_, mb_s_;
+  // J's structurally nonzero entries in the independent and driven columns, the only ones a
+  // kinematic seed reaches before the dependent rows are solved for: dh = J dq there when the
+  // parameters are not seeded, and d(J qd) = J dqd for a direction that moves no coordinate.
+  struct JacobianEntry {
+    int row, col;
+  };
+  std::vector<JacobianEntry> seeded_entries_;
   const GeneratedModel& model_;
   std::vector<int> u_, v_, f_, d_;
   std::vector<double> pad_;  // one zero for arrays of size zero

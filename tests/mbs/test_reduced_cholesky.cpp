@@ -31,6 +31,16 @@ TEST(ReducedCholesky, SolvesLikeAnIndependentFactorisationBelowAndAboveTheSmallS
     const Matrix expected = a.ldlt().solve(x);
     c.solve_in_place(x);
     EXPECT_LT(relative_difference(x, expected), 1e-12) << n;
+    if (n <= ReducedCholesky::kSmall) {  // several right-hand sides as each alone, bit for bit
+      const Matrix b = Matrix::Random(n, 5);
+      Matrix together = b;
+      c.solve_in_place(together);
+      for (int j = 0; j < 5; ++j) {
+        Eigen::VectorXd alone = b.col(j);
+        c.solve_in_place(alone);
+        EXPECT_EQ((alone - together.col(j)).cwiseAbs().maxCoeff(), 0.0) << n << ", column " << j;
+      }
+    }
     Eigen::VectorXd v = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
     const Eigen::VectorXd v_expected = a.ldlt().solve(v);
     c.solve_in_place(v);

@@ -63,8 +63,9 @@ struct Tangent {
   Matrix dout;
 };
 
-Tangent call_tangent(GeneratedTangent f, int k, const GeneratedModel& g, const Args& a,
-                     const std::vector<Direction>& dirs) {
+// Seeds for `dirs` (one unit seed each) handed to call(nd, seeds, out, dout).
+template <class Call>
+Tangent call_seeded(int k, const GeneratedModel& g, const std::vector<Direction>& dirs, Call call) {
   const int nd = static_cast<int>(dirs.size());
   std::vector<std::vector<double>> seeds(kArrays);
   for (int s = 0; s < kArrays; ++s) seeds[s].assign(static_cast<size_t>(std::max(array_size(g, s), 1)) * nd, 0.0);
@@ -73,12 +74,28 @@ Tangent call_tangent(GeneratedTangent f, int k, const GeneratedModel& g, const A
     seeds[dirs[d].array][static_cast<size_t>(d) * stride + dirs[d].index] = 1.0;
   }
   std::vector<double> out(std::max(k, 1)), dout(static_cast<size_t>(std::max(k, 1)) * nd);
-  f(a.q.data(), a.qd.data(), a.qdd.data(), a.lam.data(), a.inp.data(), a.p.data(), nd, seeds[kQ].data(),
-    seeds[kQd].data(), seeds[kQdd].data(), seeds[kInp].data(), seeds[kP].data(), out.data(), dout.data());
+  call(nd, seeds, out.data(), dout.data());
   Tangent t;
   t.out = Eigen::Map<Vector>(out.data(), k);
   t.dout = Eigen::Map<Matrix>(dout.data(), k, nd);
   return t;
+}
+
+Tangent call_tangent(GeneratedTangent f, int k, const GeneratedModel& g, const Args& a,
+                     const std::vector<Direction>& dirs) {
+  return call_seeded(k, g, dirs, [&](int nd, const std::vector<std::vector<double>>& seeds, double* out, double* dout) {
+    f(a.q.data(), a.qd.data(), a.qdd.data(), a.lam.data(), a.inp.data(), a.p.data(), nd, seeds[kQ].data(),
+      seeds[kQd].data(), seeds[kQdd].data(), seeds[kInp].data(), seeds[kP].data(), out, dout);
+  });
+}
+
+// A velocity tangent (no q seeds) on `dirs`, none of which may seed q.
+Tangent call_velocity_tangent(GeneratedVelocityTangent f, int k, const GeneratedModel& g, const Args& a,
+                              const std::vector<Direction>& dirs) {
+  return call_seeded(k, g, dirs, [&](int nd, const std::vector<std::vector<double>>& seeds, double* out, double* dout) {
+    f(a.q.data(), a.qd.data(), a.qdd.data(), a.lam.data(), a.inp.data(), a.p.data(), nd, seeds[kQd].data(),
+      seeds[kQdd].data(), seeds[kInp].data(), seeds[kP].data(), out, dout);
+  });
 }
 
 Args random_args(std::mt19937& rng, const GeneratedModel& g, const Vector& p) {
@@ -275,6 +292,34 @@ TEST_P(Tangents, ResidualMatchesCentralDifferencesOfResidual) {
   ASSERT_NE(f.g, nullptr);
   const GeneratedModel& g = *f.g;
   check_function("residual", f, g.residual_tangent, g.n + g.m, residual(g), residual(g), 1e-12, 23);
+}
+
+// The residual's velocity tangent (not seeded on q) on every direction but q's: against central
+// differences of the residual, and equal to the full tangent's columns for the same seeds.
+TEST_P(Tangents, ResidualVelocityTangentMatchesCentralDifferencesAndTheFullTangent) {
+  Fixture f(GetParam());
+  ASSERT_NE(f.g, nullptr);
+  const GeneratedModel& g = *f.g;
+  ASSERT_NE(g.residual_velocity_tangent, nullptr);
+  std::vector<Direction> dirs;
+  for (const Direction& d : directions(g))
+    if (d.array != kQ) dirs.push_back(d);
+  std::mt19937 rng(26);
+  Worst worst;
+  for (int state = 0; state < kStates; ++state) {
+    const Args a = random_args(rng, g, f.p);
+    const Tangent t = call_velocity_tangent(g.residual_velocity_tangent, g.n + g.m, g, a, dirs);
+    const Tangent full = call_tangent(g.residual_tangent, g.n + g.m, g, a, dirs);
+    EXPECT_LE((t.out - full.out).cwiseAbs().maxCoeff(), 1e-13 * std::max(full.out.cwiseAbs().maxCoeff(), 1.0))
+        << g.name << ": the velocity tangent's out is not the residual";
+    EXPECT_LE((t.dout - full.dout).cwiseAbs().maxCoeff(), 1e-12 * std::max(full.dout.cwiseAbs().maxCoeff(), 1.0))
+        << g.name << ": the velocity tangent differs from the full tangent at dq = 0";
+    const Worst w = check_entries("residual velocity", g, a, dirs, t, residual(g));
+    worst.ratio = std::max(worst.ratio, w.ratio);
+    worst.entries += w.entries;
+  }
+  RecordProperty("entries", worst.entries);
+  RecordProperty("worst_error_over_allowed", std::to_string(worst.ratio));
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, Tangents, ::testing::Values(DYDP_TEST_MODELS),
