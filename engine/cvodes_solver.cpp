@@ -206,7 +206,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   if (bdf) {
     S.A = SUNDenseMatrix(n_cv, n_cv, S.ctx);
     use_compiled_matrix_kernels(S.A);
-    S.LS = make_dense_lu_solver(S.ctx, n_cv);
+    S.LS = make_dense_lu_solver(S.ctx);
     check(CVodeSetLinearSolver(S.mem, S.LS, S.A), "CVodeSetLinearSolver");
     check(CVodeSetJacFn(S.mem, jacobian), "CVodeSetJacFn");
   } else {

@@ -59,7 +59,7 @@ int release(SUNLinearSolver S) {
 
 }  // namespace
 
-SUNLinearSolver make_dense_lu_solver(SUNContext context, int n) {
+SUNLinearSolver make_dense_lu_solver(SUNContext context) {
   SUNLinearSolver S = SUNLinSolNewEmpty(context);
   if (!S) return nullptr;
   S->ops->gettype = type;
@@ -70,8 +70,7 @@ SUNLinearSolver make_dense_lu_solver(SUNContext context, int n) {
   S->ops->lastflag = last_flag;
   S->ops->space = space;
   S->ops->free = release;
-  auto* c = new Content;
-  (void)n;  // sized at the first set-up
+  auto* c = new Content;  // sized at the first set-up
   S->content = c;
   return S;
 }

@@ -11,7 +11,7 @@
 
 namespace dydp::engine {
 
-// A solver for n x n dense matrices; free it with SUNLinSolFree.
-SUNLinearSolver make_dense_lu_solver(SUNContext context, int n);
+// A solver for square dense matrices (sized at its first set-up); free it with SUNLinSolFree.
+SUNLinearSolver make_dense_lu_solver(SUNContext context);
 
 }  // namespace dydp::engine

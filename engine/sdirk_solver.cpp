@@ -40,7 +40,7 @@ struct StageFailure {
 class Stepper {
  public:
   Stepper(const Diagram& d, Evaluator& ev, int ns, RunStats& stats)
-      : d_(d), ev_(ev), nx_(d.num_states), nq_(d.num_quadratures), ns_(ns), stats_(stats),
+      : ev_(ev), nx_(d.num_states), nq_(d.num_quadratures), ns_(ns), stats_(stats),
         jac_(nx_, nx_), identity_(Matrix::Identity(nx_, nx_)), colouring_(d) {
     stats_.jacobian_colours = colouring_.colours();
   }
@@ -156,7 +156,6 @@ class Stepper {
     }
   }
 
-  const Diagram& d_;
   Evaluator& ev_;
   int nx_, nq_, ns_;
   RunStats& stats_;

@@ -28,7 +28,7 @@ struct System {
     x = N_VNew_Serial(n, ctx);
     rhs = N_VNew_Serial(n, ctx);
     Eigen::Map<Eigen::VectorXd>(NV_DATA_S(rhs), n) = b;
-    S = dydp::engine::make_dense_lu_solver(ctx, n);
+    S = dydp::engine::make_dense_lu_solver(ctx);
   }
   ~System() {
     SUNLinSolFree(S);
