@@ -10,6 +10,7 @@ namespace {
 struct Content {
   NewtonLU lu;
   sunindextype last_flag = 0;
+  MatrixRefresh refresh;
 };
 
 Content& content(SUNLinearSolver S) { return *static_cast<Content*>(S->content); }
@@ -25,6 +26,7 @@ int initialize(SUNLinearSolver S) {
 // SUNLinSol_Dense reports it, with the (1-based) column in the last flag.
 int setup(SUNLinearSolver S, SUNMatrix A) {
   Content& c = content(S);
+  if (c.refresh) c.refresh(A);
   if (!c.lu.factor(SM_DATA_D(A), static_cast<int>(SM_ROWS_D(A)))) {
     c.last_flag = c.lu.failed_column() + 1;
     return SUNLS_LUFACT_FAIL;
@@ -74,5 +76,7 @@ SUNLinearSolver make_dense_lu_solver(SUNContext context) {
   S->content = c;
   return S;
 }
+
+void set_matrix_refresh(SUNLinearSolver solver, MatrixRefresh refresh) { content(solver).refresh = std::move(refresh); }
 
 }  // namespace dydp::engine

@@ -6,12 +6,20 @@
 // is a recoverable failure naming its column, as SUNLinSol_Dense reports it.
 #pragma once
 
+#include <functional>
+
 #include <sundials/sundials_context.h>
+#include <sundials/sundials_matrix.h>
 #include <sundials/sundials_linearsolver.h>
 
 namespace dydp::engine {
 
 // A solver for square dense matrices (sized at its first set-up); free it with SUNLinSolFree.
 SUNLinearSolver make_dense_lu_solver(SUNContext context);
+
+// Called with the Newton matrix (I - gamma J as CVODES formed it) before each factorisation, to
+// refresh parts of it in place; an empty function refreshes nothing.
+using MatrixRefresh = std::function<void(SUNMatrix)>;
+void set_matrix_refresh(SUNLinearSolver solver, MatrixRefresh refresh);
 
 }  // namespace dydp::engine

@@ -40,6 +40,10 @@ struct SolverSpec {
   /// tolerance (CVODES' nonlinear convergence coefficient, its default 0.1). A larger value
   /// stops the iteration sooner and declares fewer convergence failures (each costs a Jacobian).
   double newton_coefficient = 0.1;
+  /// BDF: the blocks' own diagonal blocks of the Newton matrix (Block::local_jacobian, the
+  /// dampers' pressures) refreshed at each set-up, with a set-up every 5 steps; false: CVODES'
+  /// own (the kept Jacobian as it is, a set-up every 20 steps).
+  bool refresh_local_jacobians = true;
 };
 
 struct SceneParameter {

@@ -79,6 +79,7 @@ std::string run_json(const Diagram& d, const RunResult& r) {
       {"sens_error_test", d.solver.sens_error_test},
       {"nominal_scaling", d.solver.nominal_scaling},
       {"newton_coefficient", d.solver.newton_coefficient},
+      {"refresh_local_jacobians", d.solver.refresh_local_jacobians},
       {"parameters", parameters},
       {"sensitivities", r.sensitivity_names},
       {"states", d.num_states},

@@ -78,7 +78,7 @@ void read_solver(const SceneReader& r, const YAML::Node& n, const TimeSpec& time
   if (!n) return check_solver_relations(r.file(), n, s, time);
   r.allow_keys(n, "solver",
                {"method", "rtol", "atol", "step", "max_steps", "min_step", "sens_error_test", "nominal_scaling",
-                "newton_coefficient"});
+                "newton_coefficient", "refresh_local_jacobians"});
   if (n["method"]) {
     s.method = r.text(n["method"], "solver.method");
     if (s.method != "bdf" && s.method != "adams" && s.method != "rk4" && s.method != "sdirk2" &&
@@ -97,6 +97,11 @@ void read_solver(const SceneReader& r, const YAML::Node& n, const TimeSpec& time
     const std::string v = r.text(e, "solver.nominal_scaling");
     if (v != "true" && v != "false") r.fail(e, "solver.nominal_scaling", "expected true or false");
     s.nominal_scaling = v == "true";
+  }
+  if (const YAML::Node e = n["refresh_local_jacobians"]) {
+    const std::string v = r.text(e, "solver.refresh_local_jacobians");
+    if (v != "true" && v != "false") r.fail(e, "solver.refresh_local_jacobians", "expected true or false");
+    s.refresh_local_jacobians = v == "true";
   }
   if (n["max_steps"]) {
     const double v = r.number(n["max_steps"], "solver.max_steps");

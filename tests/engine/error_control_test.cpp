@@ -9,6 +9,8 @@
 // the fast one sets the step until the slow one's tolerance is made far tighter.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -211,6 +213,34 @@ TEST_F(ErrorControl, ALargerNewtonCoefficientReachesCvodesAndStopsTheIterationSo
             static_cast<double>(a.stats.nonlinear_iterations) / a.stats.steps);
   EXPECT_LE(b.stats.nonlinear_failures, a.stats.nonlinear_failures);
   EXPECT_NE(run_json(loose, b).find("\"newton_coefficient\": 0.5"), std::string::npos);
+}
+
+TEST_F(ErrorControl, RefreshingTheDampersBlocksCutsNewtonFailuresAndKeepsTheSolution) {
+  // The quarter car with its CDC damper, with the sensitivity: the damper's own Jacobian block
+  // refreshed at each set-up of the Newton matrix (the default) against CVODES' kept Jacobian.
+  // Far fewer failed Newton iterations, so far fewer whole Jacobians; the same solution to the
+  // accuracy the tolerances ask for.
+  const std::string scenes = std::string(DYDP_SOURCE_DIR) + "/scenarios/";
+  Diagram refreshed = load_scene(scenes + "quarter_car_cdc.yaml");
+  Diagram kept = load_scene(scenes + "quarter_car_cdc.yaml");
+  refreshed.time.stop = kept.time.stop = 3.0;
+  EXPECT_TRUE(refreshed.solver.refresh_local_jacobians);
+  kept.solver.refresh_local_jacobians = false;
+  const RunResult a = run(refreshed, RunOptions{}), b = run(kept, RunOptions{});
+  EXPECT_GT(a.stats.local_jac_evals, 0);
+  EXPECT_EQ(b.stats.local_jac_evals, 0);
+  EXPECT_LT(2 * a.stats.nonlinear_failures, b.stats.nonlinear_failures);
+  EXPECT_LT(a.stats.jac_evals, b.stats.jac_evals);
+  ASSERT_EQ(a.objectives.size(), b.objectives.size());
+  ASSERT_FALSE(a.objectives.empty());
+  for (size_t k = 0; k < a.objectives.size(); ++k) {
+    const ObjectiveResult &x = a.objectives[k], &y = b.objectives[k];
+    EXPECT_NEAR(x.value, y.value, 1e-5 * std::fabs(y.value)) << x.name;
+    ASSERT_EQ(x.sensitivity.size(), y.sensitivity.size());
+    for (size_t d = 0; d < x.sensitivity.size(); ++d)
+      EXPECT_NEAR(x.sensitivity[d], y.sensitivity[d], 1e-4 * std::fabs(y.sensitivity[d])) << x.name << " " << d;
+  }
+  EXPECT_NE(run_json(kept, b).find("\"refresh_local_jacobians\": false"), std::string::npos);
 }
 
 TEST_F(ErrorControl, BadNominalsAreRefusedWithFileLineAndField) {

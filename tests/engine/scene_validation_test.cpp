@@ -615,6 +615,13 @@ TEST_F(SceneValidation, NewtonCoefficientOutsideTheUnitInterval) {
   }
 }
 
+TEST_F(SceneValidation, SolverSwitchesAreTrueOrFalse) {
+  for (const char* key : {"sens_error_test", "nominal_scaling", "refresh_local_jacobians"}) {
+    const std::string path = write("s.yaml", scene_with_solver_setting(std::string(key) + ": maybe"));
+    expect_error(load_error(path), path, 5, std::string("solver.") + key, "expected true or false");
+  }
+}
+
 TEST_F(SceneValidation, MalformedCsvTableNamesTheCsvFileAndRow) {
   const std::string csv = write("road.csv", "t,z\n0.0,0.0\n0.5,0.01\n1.0,abc\n");
   const std::string path = write("s.yaml", R"(scene: t
