@@ -121,6 +121,8 @@ void Evaluator::outputs(double t, const double* x) {
   const int nx = d_.num_states;
   if (valid_ && t == last_t_ && (nx == 0 || std::memcmp(x, last_x_.data(), nx * sizeof(double)) == 0))
     return;
+  valid_ = false;  // until every block has written its outputs: a block that refuses the point
+                   // leaves the signals half new, which must not pass for the last point's
   for (const OutputStep& step : d_.output_steps) {
     const int i = step.node;
     const Node& n = d_.nodes[i];
