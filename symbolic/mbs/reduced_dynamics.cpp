@@ -138,7 +138,7 @@ void ReducedDynamics::solve_kinematics(const double* u, const double* ud, const 
     }
     r.Jv.invert();  // the factors at the solution serve many right-hand sides from here on
     r.J = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(w.hj.data() + m, m, n);
-    w.fv.noalias() = r.J * r.qd;  // Jv vd = -J qd (vd still zero in qd)
+    jacobian_times(r.J, r.qd.data(), w.fv.data());  // Jv vd = -J qd (vd still zero in qd: J's seeded columns)
     r.Jv.solve(w.fv.data(), m, 1, w.fv.data(), m);
     for (int i = 0; i < m; ++i) r.qd[v_[i]] = -w.fv[i];
   }
