@@ -339,7 +339,7 @@ void ReducedDynamics::tangent_kinematics(const Result& r, const double* inputs, 
     // the others (when they come first, on those only).
     split_directions(dq, parameters_seeded ? &w.dp : nullptr, nd, w.moving, w.still);
     const int k = static_cast<int>(w.moving.size());
-    const int solved = k == 0 || w.moving.back() == k - 1 ? k : nd;
+    const int solved = leading(w.moving) ? k : nd;
     if (parameters_seeded) {
       model_.constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, nd, dq.data(),
                                  dqd.data(), w.dqdd_seed.data(), w.dinp.data(), w.dp.data(), w.out.data(),
@@ -354,19 +354,11 @@ void ReducedDynamics::tangent_kinematics(const Result& r, const double* inputs, 
                                           dq.data(), dqd.data(), w.dqdd_seed.data(), w.dinp.data(), w.dp.data(),
                                           w.out.data(), w.dout.data());
     } else {
-      if (k > 0 && w.moving.back() == k - 1) {  // the first k directions: the seeds as they are
+      if (k > 0) {
+        const DirectionSeeds s = directions(w.moving, dq, dqd, w.dqdd_seed, w.dout, w);
         model_.velocity_constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, k,
-                                            dq.data(), dqd.data(), w.dqdd_seed.data(), w.dinp.data(), w.dp.data(),
-                                            w.out.data(), w.dout.data());
-      } else if (k > 0) {
-        gather_columns(dq, w.moving, w.g_dq), gather_columns(dqd, w.moving, w.g_dqd);
-        gather_columns(w.dqdd_seed, w.moving, w.g_dqdd), gather_columns(w.dinp, w.moving, w.g_dinp);
-        gather_columns(w.dp, w.moving, w.g_dp);
-        w.g_dout.resize(2 * m, k);
-        model_.velocity_constraints_tangent(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, k,
-                                            w.g_dq.data(), w.g_dqd.data(), w.g_dqdd.data(), w.g_dinp.data(),
-                                            w.g_dp.data(), w.out.data(), w.g_dout.data());
-        for (int c = 0; c < k; ++c) w.dout.col(w.moving[c]) = w.g_dout.col(c);
+                                            s.dq, s.dqd, s.dqdd, s.dinp, s.dp, w.out.data(), s.dout);
+        put_directions(w.moving, w, w.dout);
       }
       for (int d : w.still) jacobian_times(r.J, dqd.data() + d * n, w.dout.data() + d * 2 * m + m);
     }
@@ -395,6 +387,29 @@ void ReducedDynamics::gather_columns(const Matrix& a, const std::vector<int>& co
   for (std::size_t c = 0; c < cols.size(); ++c) out.col(static_cast<Eigen::Index>(c)) = a.col(cols[c]);
 }
 
+bool ReducedDynamics::leading(const std::vector<int>& cols) {
+  for (std::size_t c = 0; c < cols.size(); ++c)
+    if (cols[c] != static_cast<int>(c)) return false;
+  return true;
+}
+
+ReducedDynamics::DirectionSeeds ReducedDynamics::directions(const std::vector<int>& cols, const Matrix& dq,
+                                                            const Matrix& dqd, const Matrix& dqdd, Matrix& dout,
+                                                            Result::Work& w) {
+  if (leading(cols))
+    return {dq.data(), dqd.data(), dqdd.data(), w.dinp.data(), w.dp.data(), w.dinp.rows(), w.dp.rows(), dout.data()};
+  gather_columns(dq, cols, w.g_dq), gather_columns(dqd, cols, w.g_dqd), gather_columns(dqdd, cols, w.g_dqdd);
+  gather_columns(w.dinp, cols, w.g_dinp), gather_columns(w.dp, cols, w.g_dp);
+  w.g_dout.resize(dout.rows(), static_cast<Eigen::Index>(cols.size()));
+  return {w.g_dq.data(),   w.g_dqd.data(),   w.g_dqdd.data(),  w.g_dinp.data(),
+          w.g_dp.data(),   w.g_dinp.rows(),  w.g_dp.rows(),    w.g_dout.data()};
+}
+
+void ReducedDynamics::put_directions(const std::vector<int>& cols, Result::Work& w, Matrix& dout) {
+  if (leading(cols)) return;
+  for (std::size_t c = 0; c < cols.size(); ++c) dout.col(cols[c]) = w.g_dout.col(static_cast<Eigen::Index>(c));
+}
+
 void ReducedDynamics::residual_tangent(const Result& r, const double* lam, const double* in, const double* p, int nd,
                                        const Matrix& dq, const Matrix& dqd, const Matrix& dqdd) const {
   Result::Work& w = r.work;
@@ -407,30 +422,19 @@ void ReducedDynamics::residual_tangent(const Result& r, const double* lam, const
                             dqdd.data(), w.dinp.data(), w.dp.data(), w.out.data(), w.dout.data());
     return;
   }
-  // the moving directions' tangent, then the others' (dq = 0) from the velocity tangent, for
+  // the moving directions' tangent, then the others' (dq = 0) from the velocity tangent, on
   // seeds whose first k columns are the moving directions
   const int k = static_cast<int>(w.moving.size());
-  auto run = [&](const double* sq, const double* sqd, const double* sqdd, const double* sinp, const double* sp,
-                 Eigen::Index ld_inp, Eigen::Index ld_p, double* dout) {
-    if (k > 0)
-      model_.residual_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam, in, p, k, sq, sqd, sqdd, sinp, sp,
-                              w.out.data(), dout);
-    model_.residual_velocity_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam, in, p, nd - k, sqd + k * n,
-                                     sqdd + k * n, sinp + k * ld_inp, sp + k * ld_p, w.out.data(),
-                                     dout + static_cast<Eigen::Index>(k) * rows);
-  };
-  if (k == 0 || w.moving.back() == k - 1) {  // the first k directions (moving holds them in order)
-    run(dq.data(), dqd.data(), dqdd.data(), w.dinp.data(), w.dp.data(), w.dinp.rows(), w.dp.rows(), w.dout.data());
-    return;
-  }
   std::vector<int>& order = w.moving;  // moving, then still
   order.insert(order.end(), w.still.begin(), w.still.end());
-  gather_columns(dq, order, w.g_dq), gather_columns(dqd, order, w.g_dqd), gather_columns(dqdd, order, w.g_dqdd);
-  gather_columns(w.dinp, order, w.g_dinp), gather_columns(w.dp, order, w.g_dp);
-  w.g_dout.resize(rows, nd);
-  run(w.g_dq.data(), w.g_dqd.data(), w.g_dqdd.data(), w.g_dinp.data(), w.g_dp.data(), w.g_dinp.rows(),
-      w.g_dp.rows(), w.g_dout.data());
-  for (int c = 0; c < nd; ++c) w.dout.col(order[c]) = w.g_dout.col(c);
+  const DirectionSeeds s = directions(order, dq, dqd, dqdd, w.dout, w);
+  if (k > 0)
+    model_.residual_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam, in, p, k, s.dq, s.dqd, s.dqdd, s.dinp, s.dp,
+                            w.out.data(), s.dout);
+  model_.residual_velocity_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam, in, p, nd - k, s.dqd + k * n,
+                                   s.dqdd + k * n, s.dinp + k * s.ld_inp, s.dp + k * s.ld_p, w.out.data(),
+                                   s.dout + static_cast<Eigen::Index>(k) * rows);
+  put_directions(order, w, w.dout);
 }
 
 void ReducedDynamics::tangent(const Result& r, const double* inputs, const double* p, int nd, const double* du,

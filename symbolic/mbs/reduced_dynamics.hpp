@@ -107,6 +107,20 @@ class ReducedDynamics {
                                std::vector<int>& still);
   // out = the columns `cols` of a, in that order.
   static void gather_columns(const Matrix& a, const std::vector<int>& cols, Matrix& out);
+  // Whether cols is 0, 1, ..., k - 1: those directions are the seeds' leading columns as they are.
+  static bool leading(const std::vector<int>& cols);
+  // The seeds of the directions `cols` (in that order) as consecutive columns for a generated
+  // tangent, and where its derivatives go: the arrays themselves (dq, dqd, dqdd, work's dinp and
+  // dp; dout) when cols lead, otherwise copies gathered into work's g_ arrays (g_dout sized
+  // dout.rows() x cols), which put_directions then copies back to dout's columns `cols`.
+  struct DirectionSeeds {
+    const double *dq, *dqd, *dqdd, *dinp, *dp;
+    Eigen::Index ld_inp, ld_p;
+    double* dout;
+  };
+  static DirectionSeeds directions(const std::vector<int>& cols, const Matrix& dq, const Matrix& dqd,
+                                   const Matrix& dqdd, Matrix& dout, Result::Work& w);
+  static void put_directions(const std::vector<int>& cols, Result::Work& w, Matrix& dout);
   // The residual's tangent (dr, da) into r.work.dout for the seeds dq, dqd, dqdd and
   // r.work.dinp, dp: the directions with dq = 0 through the model's velocity tangent, which
   // skips every derivative of the rotations and positions.
