@@ -168,7 +168,27 @@ bool BlockLU::compute(const Matrix& A, const std::vector<int>& cols) {
 }
 
 bool BlockLU::compute_rows(const double* a, Eigen::Index ld, const std::vector<int>& cols) {
-  return compute_from([a, ld](int i, int j) { return a[i * ld + j]; }, cols);
+  if (static_cast<int>(cols.size()) != size_) throw std::invalid_argument("BlockLU: size differs from the pattern");
+  if (ld != gather_ld_ || cols != gather_cols_) {
+    gather_.clear();
+    for (const Block& b : blocks_) {
+      const int k = static_cast<int>(b.rows.size());
+      for (int c = 0; c < k; ++c)
+        for (int i = 0; i < k; ++i) gather_.push_back(b.rows[i] * ld + cols[b.cols[c]]);
+    }
+    gather_ld_ = ld;
+    gather_cols_ = cols;
+  }
+  bool regular = true;
+  inverted_ = false;
+  const Eigen::Index* from = gather_.data();
+  for (Block& b : blocks_) {
+    const std::size_t entries = b.lu.size();
+    for (std::size_t t = 0; t < entries; ++t) b.lu[t] = a[from[t]];
+    from += entries;
+    regular = factor(b) && regular;
+  }
+  return regular;
 }
 
 void BlockLU::solve(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs, double* x, Eigen::Index ldx) const {

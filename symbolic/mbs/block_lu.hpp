@@ -57,6 +57,12 @@ class BlockLU {
   void substitute(const double* b, Eigen::Index ldb, Eigen::Index nrhs, double* x, Eigen::Index ldx) const;
   bool inverted_ = false;
   std::vector<Block> blocks_;
+  // compute_rows' reads: block by block, entry t of its lu at a[gather_[start + t]], for the
+  // leading dimension and columns it was last called with (a Newton iteration calls it with the
+  // same ones every time)
+  std::vector<Eigen::Index> gather_;
+  Eigen::Index gather_ld_ = -1;
+  std::vector<int> gather_cols_;
   int size_ = 0;
   mutable std::vector<double> work_;  // a right-hand side gathered whole (x may be b), then a block's part
 };

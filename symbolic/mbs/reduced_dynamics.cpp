@@ -77,13 +77,20 @@ ReducedDynamics::ReducedDynamics(const GeneratedModel& model) : model_(model), p
       if (i != j)
         for (int t = s_start_[i]; t < s_start_[i + 1]; ++t) terms[static_cast<std::size_t>(j) * k + s_col_[t]].emplace_back(e, t);
     }
+    std::vector<char> unit(s_col_.size(), 0);  // [B beta]'s entry is an independent row's 1
+    for (const IndependentRow& row : independent_rows_) unit[s_start_[row.q]] = 1;
     mb_start_.assign(1, 0);
     for (std::size_t o = 0; o < terms.size(); ++o) {
       if (terms[o].empty()) continue;
       mb_place_.push_back(static_cast<int>(o));
+      mb_unit_.push_back(model.mass_entries);  // the zero after M's entries
       for (const auto& [e, t] : terms[o]) {
-        mb_mass_.push_back(e);
-        mb_s_.push_back(t);
+        if (unit[t]) {
+          mb_unit_.back() = e;  // (one at most: column c has a single independent row)
+        } else {
+          mb_mass_.push_back(e);
+          mb_s_.push_back(t);
+        }
       }
       mb_start_.push_back(static_cast<int>(mb_mass_.size()));
     }
@@ -137,7 +144,7 @@ void ReducedDynamics::solve_kinematics(const double* u, const double* ud, const 
       for (int i = 0; i < m; ++i) r.q[v_[i]] -= w.fv[i];
     }
     r.Jv.invert();  // the factors at the solution serve many right-hand sides from here on
-    r.J = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(w.hj.data() + m, m, n);
+    r.J = Eigen::Map<const RowMatrix>(w.hj.data() + m, m, n);
     jacobian_times(r.J, r.qd.data(), w.fv.data());  // Jv vd = -J qd (vd still zero in qd: J's seeded columns)
     r.Jv.solve(w.fv.data(), m, 1, w.fv.data(), m);
     for (int i = 0; i < m; ++i) r.qd[v_[i]] = -w.fv[i];
@@ -204,11 +211,12 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   if (model_.mass_matrix) {
     // M's structurally nonzero entries by composite inertias times the structurally nonzero
     // entries of [B beta]: a corner's rows meet a corner's two or three columns
-    w.mass.resize(std::max(1, model_.mass_entries));
+    w.mass.resize(model_.mass_entries + 1);
     model_.mass_matrix(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, w.mass.data());
-    w.s_val.resize(s_col_.size());
-    for (int j = 0; j < n; ++j) {
-      const int a = free_row_of_[j];
+    w.mass[model_.mass_entries] = 0.0;
+    w.s_val.resize(s_col_.size());  // (the dependent rows': the independent ones' 1 is not read)
+    for (const auto& [a, place] : dependent_rows_) {
+      const int j = f_[a];
       for (int t = s_start_[j]; t < s_start_[j + 1]; ++t) w.s_val[t] = s_col_[t] < nu ? r.B(a, s_col_[t]) : w.beta[a];
     }
     r.MB.setZero();
@@ -218,8 +226,9 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
     const int* start = mb_start_.data();
     const int* at_mass = mb_mass_.data();
     const int* at_s = mb_s_.data();
+    const int* at_unit = mb_unit_.data();
     for (std::size_t o = 0; o < mb_place_.size(); ++o) {
-      double sum = 0.0;
+      double sum = mass[at_unit[o]];
       for (int t = start[o]; t < start[o + 1]; ++t) sum += mass[at_mass[t]] * val[at_s[t]];
       mb[mb_place_[o]] = sum;
     }
@@ -367,7 +376,7 @@ void ReducedDynamics::tangent_kinematics(const Result& r, const double* inputs, 
   }
 }
 
-void ReducedDynamics::jacobian_times(const Matrix& J, const double* x, double* out) const {
+void ReducedDynamics::jacobian_times(const RowMatrix& J, const double* x, double* out) const {
   for (int i = 0; i < model_.m; ++i) out[i] = 0.0;
   for (const JacobianEntry& e : seeded_entries_) out[e.row] += J(e.row, e.col) * x[e.col];
 }

@@ -34,7 +34,7 @@ class ReducedDynamics {
     Vector q, qd, qdd, lam;
     Vector udd;
     RowMatrix MB;                                 // M [B beta]: n x (nu + 1 if m > 0)
-    Matrix J;                                     // m x n
+    RowMatrix J;                                  // m x n (as the generated function writes it)
     BlockLU Jv;                                   // dependent columns of J, loop by loop
     RowMatrix B;                                  // free coordinates x nu
     ReducedCholesky reduced;                      // B^T M_ff B
@@ -101,7 +101,7 @@ class ReducedDynamics {
   void dynamics_from_seeds(const Result& r, const double* inputs, const double* p, int nd, const Matrix& dq,
                            const Matrix& dqd, Matrix& dqdd) const;
   // out (m) = J x over seeded_entries_ (x: n entries, zero in the dependent ones).
-  void jacobian_times(const Matrix& J, const double* x, double* out) const;
+  void jacobian_times(const RowMatrix& J, const double* x, double* out) const;
   // The directions (columns) with a nonzero dq, or a nonzero dp when dp is given, and the others.
   static void split_directions(const Matrix& dq, const Matrix* dp, int nd, std::vector<int>& moving,
                                std::vector<int>& still);
@@ -153,7 +153,10 @@ class ReducedDynamics {
   // the sum over p in mb_start_[o] .. mb_start_[o + 1] - 1 of mass[mb_mass_[p]] * s_val[mb_s_[p]],
   // the products of M's structurally nonzero entries (both triangles) and [B beta]'s, in the
   // order a scatter over M's entries would add them. Entries with no product stay zero.
-  std::vector<int> mb_place_, mb_start_, mb_mass_, mb_s_;
+  // An independent coordinate's row of [B beta] holds a single 1 (in its own column), so an
+  // entry of the product has at most one such term, M's entry itself: mb_unit_[o] (or the
+  // index of a zero after M's entries) starts the sum, and the gathered products are the others.
+  std::vector<int> mb_place_, mb_start_, mb_mass_, mb_s_, mb_unit_;
   // J's structurally nonzero entries in the independent and driven columns, the only ones a
   // kinematic seed reaches before the dependent rows are solved for: dh = J dq there when the
   // parameters are not seeded, and d(J qd) = J dqd for a direction that moves no coordinate.
