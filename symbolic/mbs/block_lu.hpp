@@ -40,6 +40,9 @@ class BlockLU {
   // The rows and the columns of block b (indices into the pattern).
   const std::vector<int>& block_rows(int b) const { return blocks_[b].rows; }
   const std::vector<int>& block_cols(int b) const { return blocks_[b].cols; }
+  // Block b's inverse after invert(): k x k row-major, x[block_cols[i]] = sum over j of
+  // inverse[i * k + j] * b[block_rows[j]].
+  const double* block_inverse(int b) const { return blocks_[b].inverse.data(); }
   int size() const { return size_; }
 
  private:

@@ -42,17 +42,20 @@ ReducedDynamics::ReducedDynamics(const GeneratedModel& model) : model_(model), p
       if (reads) block_u[b].push_back(i);
     }
   }
+  block_u_ = block_u;
   b_cols_.resize(f_.size());
   free_row_of_.assign(n, -1);
   for (std::size_t a = 0; a < f_.size(); ++a) {
     free_row_of_[f_[a]] = static_cast<int>(a);
     b_cols_[a] = free_place_[a] >= 0 ? std::vector<int>{free_place_[a]} : block_u[block_of_v[-1 - free_place_[a]]];
   }
+  row_of_v_.assign(model.m, -1);
   for (std::size_t a = 0; a < f_.size(); ++a) {
     if (free_place_[a] >= 0) {
       independent_rows_.push_back({f_[a], free_place_[a]});
     } else {
       dependent_rows_.emplace_back(static_cast<int>(a), -1 - free_place_[a]);
+      row_of_v_[-1 - free_place_[a]] = static_cast<int>(a);
       for (int c : b_cols_[a]) dependent_entries_.push_back({f_[a], c, static_cast<int>(a) * nu + c});
     }
   }
@@ -180,26 +183,37 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
 
   const int nf = static_cast<int>(f_.size());
   // B over the free coordinates: rows u (identity) and v (-Jv^-1 Ju).
-  r.B.resize(nf, nu);  // every entry written below
-  w.beta.resize(nf);
+  // (B's entries outside its structure are zero, and its independent rows' 1s in place, from
+  // the call that shaped it: each call writes the dependent rows' structural entries)
+  if (r.B.rows() != nf || r.B.cols() != nu || w.b_owner != this) {
+    r.B.setZero(nf, nu);
+    for (int a = 0; a < nf; ++a)
+      if (free_place_[a] >= 0) r.B(a, free_place_[a]) = 1.0;
+    w.b_owner = this;
+  }
+  w.beta.setZero(nf);
   if (m > 0) {
-    w.Ju.resize(m, nu);
-    for (int i = 0; i < nu; ++i) w.Ju.col(i) = r.J.col(u_[i]);
-    w.Bv.resize(m, nu);
-    r.Jv.solve(w.Ju.data(), m, nu, w.Bv.data(), m);
+    // Bv = -Jv^-1 Ju block by block, over the u columns that reach each block: the block's
+    // inverse times its rows of J's column
+    const double* J = r.J.data();  // row-major
+    double* z = w.fv.data();       // (m entries: a block's part of one column)
+    for (int b = 0; b < r.Jv.blocks(); ++b) {
+      const std::vector<int>& rows = r.Jv.block_rows(b);
+      const std::vector<int>& cols = r.Jv.block_cols(b);
+      const int kb = static_cast<int>(rows.size());
+      const double* inv = r.Jv.block_inverse(b);
+      for (int c : block_u_[b]) {
+        for (int j = 0; j < kb; ++j) z[j] = J[static_cast<Eigen::Index>(rows[j]) * n + u_[c]];
+        for (int i = 0; i < kb; ++i) {
+          double x = 0.0;
+          for (int j = 0; j < kb; ++j) x += inv[i * kb + j] * z[j];
+          r.B(row_of_v_[cols[i]], c) = -x;
+        }
+      }
+    }
     w.beta_v.resize(m, 1);
     r.Jv.solve(a0.data(), m, 1, w.beta_v.data(), m);
-  }
-  for (int a = 0; a < nf; ++a) {
-    const int place = free_place_[a];
-    if (place >= 0) {
-      r.B.row(a).setZero();
-      r.B(a, place) = 1.0;
-      w.beta[a] = 0.0;
-    } else {
-      r.B.row(a) = -w.Bv.row(-1 - place);
-      w.beta[a] = -w.beta_v(-1 - place, 0);
-    }
+    for (const auto& [a, place] : dependent_rows_) w.beta[a] = -w.beta_v(place, 0);
   }
 
   // a tree (no constraints, u in coordinate order): B = I, M B = M, and the products would cost
@@ -207,7 +221,12 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   const bool identity = m == 0 && u_ == f_;
   // M [B beta]: M qdd for qdd = B udd + beta is all we need.
   const int k = nu + (m > 0 ? 1 : 0);
-  r.MB.resize(n, k);
+  // (the entries outside the product's structure are zero from the first call on: r.MB is
+  // zeroed only when it takes its shape, or comes from another model's partitioning)
+  if (r.MB.rows() != n || r.MB.cols() != k || w.mb_owner != this) {
+    r.MB.setZero(n, k);
+    w.mb_owner = this;
+  }
   if (model_.mass_matrix) {
     // M's structurally nonzero entries by composite inertias times the structurally nonzero
     // entries of [B beta]: a corner's rows meet a corner's two or three columns
@@ -219,7 +238,6 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
       const int j = f_[a];
       for (int t = s_start_[j]; t < s_start_[j + 1]; ++t) w.s_val[t] = s_col_[t] < nu ? r.B(a, s_col_[t]) : w.beta[a];
     }
-    r.MB.setZero();
     double* __restrict mb = r.MB.data();
     const double* mass = w.mass.data();
     const double* val = w.s_val.data();

@@ -47,12 +47,14 @@ class ReducedDynamics {
     struct Work {
       std::vector<double> hj, res, out, lam_zero, mass, s_val;
       Vector beta, cf, Mbeta, fv, qddf;
-      Matrix Ju, Bv, beta_v, reduced, MBv, mass_columns;
+      Matrix beta_v, reduced, MBv, mass_columns;
       Matrix dinp, dp, dqdd_seed, dout, dh, dv, dbeta_v, dudd;
       // directions that move the coordinates (dq != 0) and those that do not, and their seeds
       // gathered in that order when they are not already
       std::vector<int> moving, still;
       Matrix g_dq, g_dqd, g_dqdd, g_dinp, g_dp, g_dout;
+      const void* mb_owner = nullptr;  // the partitioning that last shaped MB
+      const void* b_owner = nullptr;   // and B
     };
     mutable Work work;
   };
@@ -133,6 +135,10 @@ class ReducedDynamics {
   // corner's two or three of the car's fourteen). M [B beta], B^T M B and the products with B
   // run over these only.
   std::vector<std::vector<int>> b_cols_;
+  // the u columns that reach each block of Jv (Ju's structurally nonzero columns on its rows),
+  // and the free row of each dependent coordinate (by its place among v)
+  std::vector<std::vector<int>> block_u_;
+  std::vector<int> row_of_v_;
   // The same by rows for the tangent's loops: an independent row's coordinate q and its column
   // (B's entry 1); a dependent row's entries, coordinate q, column c and the entry's place b in
   // B's row-major storage (a * nu + c); and the dependent rows' free row a with their place
