@@ -148,15 +148,15 @@ bool BlockLU::compute(const Matrix& A) {
   return regular;
 }
 
-template <typename Entry>
-bool BlockLU::compute_from(Entry entry, const std::vector<int>& cols) {
+template <typename Fill>
+bool BlockLU::compute_from(Fill fill, const std::vector<int>& cols) {
   if (static_cast<int>(cols.size()) != size_) throw std::invalid_argument("BlockLU: size differs from the pattern");
   bool regular = true;
   inverted_ = false;
+  std::size_t first = 0;
   for (Block& b : blocks_) {
-    const int k = static_cast<int>(b.rows.size());
-    for (int c = 0; c < k; ++c)
-      for (int i = 0; i < k; ++i) b.lu[c * k + i] = entry(b.rows[i], cols[b.cols[c]]);
+    fill(b, first);
+    first += b.lu.size();
     regular = factor(b) && regular;
   }
   return regular;
@@ -164,31 +164,32 @@ bool BlockLU::compute_from(Entry entry, const std::vector<int>& cols) {
 
 bool BlockLU::compute(const Matrix& A, const std::vector<int>& cols) {
   if (A.rows() != size_) throw std::invalid_argument("BlockLU: size differs from the pattern");
-  return compute_from([&A](int i, int j) { return A(i, j); }, cols);
+  return compute_from(
+      [&A, &cols](Block& b, std::size_t) {
+        const int k = static_cast<int>(b.rows.size());
+        for (int c = 0; c < k; ++c)
+          for (int i = 0; i < k; ++i) b.lu[c * k + i] = A(b.rows[i], cols[b.cols[c]]);
+      },
+      cols);
 }
 
 bool BlockLU::compute_rows(const double* a, Eigen::Index ld, const std::vector<int>& cols) {
-  if (static_cast<int>(cols.size()) != size_) throw std::invalid_argument("BlockLU: size differs from the pattern");
-  if (ld != gather_ld_ || cols != gather_cols_) {
-    gather_.clear();
-    for (const Block& b : blocks_) {
-      const int k = static_cast<int>(b.rows.size());
-      for (int c = 0; c < k; ++c)
-        for (int i = 0; i < k; ++i) gather_.push_back(b.rows[i] * ld + cols[b.cols[c]]);
-    }
-    gather_ld_ = ld;
-    gather_cols_ = cols;
-  }
-  bool regular = true;
-  inverted_ = false;
-  const Eigen::Index* from = gather_.data();
-  for (Block& b : blocks_) {
-    const std::size_t entries = b.lu.size();
-    for (std::size_t t = 0; t < entries; ++t) b.lu[t] = a[from[t]];
-    from += entries;
-    regular = factor(b) && regular;
-  }
-  return regular;
+  return compute_from(
+      [&](Block& b, std::size_t first) {
+        if (first == 0 && (ld != gather_ld_ || cols != gather_cols_)) {  // (cols' size checked by now)
+          gather_.clear();
+          for (const Block& each : blocks_) {
+            const int k = static_cast<int>(each.rows.size());
+            for (int c = 0; c < k; ++c)
+              for (int i = 0; i < k; ++i) gather_.push_back(each.rows[i] * ld + cols[each.cols[c]]);
+          }
+          gather_ld_ = ld;
+          gather_cols_ = cols;
+        }
+        const Eigen::Index* from = gather_.data() + first;
+        for (std::size_t t = 0; t < b.lu.size(); ++t) b.lu[t] = a[from[t]];
+      },
+      cols);
 }
 
 void BlockLU::solve(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs, double* x, Eigen::Index ldx) const {

@@ -53,8 +53,10 @@ class BlockLU {
     std::vector<double> inverse;  // k x k, row-major: block column c of x = sum over block rows
   };
   bool factor(Block& b);
-  template <typename Entry>
-  bool compute_from(Entry entry, const std::vector<int>& cols);
+  // Checks cols' size, then fill(block, first) sets each block's lu (first: the offset of its
+  // entries among all blocks') and the block is factored.
+  template <typename Fill>
+  bool compute_from(Fill fill, const std::vector<int>& cols);
   // z := A_block^-1 z through the factors (the block's exchanges, then L and U)
   static void apply_factors(const Block& b, double* z);
   void substitute(const double* b, Eigen::Index ldb, Eigen::Index nrhs, double* x, Eigen::Index ldx) const;

@@ -183,14 +183,18 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
 
   const int nf = static_cast<int>(f_.size());
   // B over the free coordinates: rows u (identity) and v (-Jv^-1 Ju).
-  // (B's entries outside its structure are zero, and its independent rows' 1s in place, from
-  // the call that shaped it: each call writes the dependent rows' structural entries)
-  if (r.B.rows() != nf || r.B.cols() != nu || w.b_owner != this) {
+  // B's and M [B beta]'s entries outside their structure, and B's independent rows' 1s, are
+  // written when they take their shape (or come from another model's partitioning); each call
+  // writes the structural entries only.
+  const bool reshape = w.shaped_by != this;
+  w.shaped_by = this;
+  const int k = nu + (m > 0 ? 1 : 0);  // [B beta]'s columns
+  if (reshape || r.B.rows() != nf || r.B.cols() != nu) {
     r.B.setZero(nf, nu);
     for (int a = 0; a < nf; ++a)
       if (free_place_[a] >= 0) r.B(a, free_place_[a]) = 1.0;
-    w.b_owner = this;
   }
+  if (reshape || r.MB.rows() != n || r.MB.cols() != k) r.MB.setZero(n, k);
   w.beta.setZero(nf);
   if (m > 0) {
     // Bv = -Jv^-1 Ju block by block, over the u columns that reach each block: the block's
@@ -220,13 +224,6 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   // two dense n^3 products
   const bool identity = m == 0 && u_ == f_;
   // M [B beta]: M qdd for qdd = B udd + beta is all we need.
-  const int k = nu + (m > 0 ? 1 : 0);
-  // (the entries outside the product's structure are zero from the first call on: r.MB is
-  // zeroed only when it takes its shape, or comes from another model's partitioning)
-  if (r.MB.rows() != n || r.MB.cols() != k || w.mb_owner != this) {
-    r.MB.setZero(n, k);
-    w.mb_owner = this;
-  }
   if (model_.mass_matrix) {
     // M's structurally nonzero entries by composite inertias times the structurally nonzero
     // entries of [B beta]: a corner's rows meet a corner's two or three columns

@@ -53,8 +53,7 @@ class ReducedDynamics {
       // gathered in that order when they are not already
       std::vector<int> moving, still;
       Matrix g_dq, g_dqd, g_dqdd, g_dinp, g_dp, g_dout;
-      const void* mb_owner = nullptr;  // the partitioning that last shaped MB
-      const void* b_owner = nullptr;   // and B
+      const void* shaped_by = nullptr;  // the partitioning that last shaped B and MB
     };
     mutable Work work;
   };
