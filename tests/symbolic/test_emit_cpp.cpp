@@ -27,12 +27,12 @@ using TangentFn = void (*)(const double*, const double*, const double*, int, con
 class SharedObject {
  public:
   // Compiles `source` into a shared object in a fresh directory and loads it.
-  explicit SharedObject(const std::string& source, const std::string& tag) {
+  explicit SharedObject(const std::string& source, const std::string& tag, const std::string& flags = "") {
     dir_ = fs::path(DYDP_TEST_WORK_DIR) / ("emit_" + tag + "_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
     std::ofstream(dir_ / "model.cpp") << source;
     const std::string command = std::string("\"") + DYDP_TEST_CXX_COMPILER +
-                                "\" -std=c++20 -O2 -Wall -Wextra -Werror -shared -fPIC -o \"" +
+                                "\" -std=c++20 -O2 -Wall -Wextra -Werror -shared -fPIC " + flags + " -o \"" +
                                 (dir_ / "model.so").string() + "\" \"" +
                                 (dir_ / "model.cpp").string() + "\" 2> \"" +
                                 (dir_ / "compile.log").string() + "\"";
@@ -127,6 +127,56 @@ TEST(EmitCpp, CompiledFunctionsAgreeWithTheInterpreter) {
         }
       }
     }
+  }
+}
+
+TEST(EmitCpp, VectorClonesAgreeToTheBitWithABaselineBuild) {
+  // The emitted functions carry GCC's target_clones (AVX2 and the baseline, bound at load time):
+  // the same source built with the attribute off runs the baseline code only. Both must give
+  // the same numbers to the bit (no fused multiply-add in either), for plain functions and for
+  // tangents in passes of two and one.
+  Context ctx;
+  EquationList raw(ctx);
+  const auto model = testing::make_random_list(raw, 300, 6, 11);
+  const EquationList list = eliminate(raw);
+  const ArrayId seeded_arrays[2] = {model.q, model.qd};
+  const EquationList tangent = tangent_list(list, seeded_arrays);
+  EmitOptions options;
+  options.origin = "random list, seed 11";
+  options.extern_c = true;
+  options.function_name = "f";
+  std::vector<EmittedFunction> functions{emit_function(list, options)};
+  options.function_name = "f_tangent";
+  functions.push_back(emit_tangent(tangent, seeded_arrays, options));
+  const std::string source = emit_source_file(functions, "", options);
+  EXPECT_NE(source.find("target_clones(\"avx2\", \"default\")"), std::string::npos);
+  const SharedObject cloned(source, "clones"), baseline(source, "baseline", "-DDYDP_VECTOR_CLONES=");
+  ASSERT_TRUE(cloned.ok()) << cloned.log();
+  ASSERT_TRUE(baseline.ok()) << baseline.log();
+  const std::size_t m = list.outputs().size();
+  const int nd = 3;
+  for (unsigned point = 0; point < 5; ++point) {
+    testing::ArrayValues<double> x(ctx);
+    for (std::size_t a = 0; a < x.values.size(); ++a)
+      x.values[a] = testing::random_values(x.values[a].size(), 700 * point + static_cast<unsigned>(a), 1.3);
+    const double* q = x.values[model.q].data();
+    const double* qd = x.values[model.qd].data();
+    const double* p = x.values[model.p].data();
+    const std::vector<double> seed_q = testing::random_values(4 * nd, point + 80);
+    const std::vector<double> seed_qd = testing::random_values(4 * nd, point + 90);
+    std::vector<double> out[2], tangent_out[2], dout[2];
+    for (int build = 0; build < 2; ++build) {
+      const SharedObject& so = build == 0 ? cloned : baseline;
+      out[build].assign(m, -1.0);
+      tangent_out[build].assign(m, -1.0);
+      dout[build].assign(m * nd, -1.0);
+      so.get<Plain>("f")(q, qd, p, out[build].data());
+      so.get<TangentFn>("f_tangent")(q, qd, p, nd, seed_q.data(), seed_qd.data(), tangent_out[build].data(),
+                                     dout[build].data());
+    }
+    EXPECT_EQ(out[0], out[1]) << "point " << point;
+    EXPECT_EQ(tangent_out[0], tangent_out[1]) << "point " << point;
+    EXPECT_EQ(dout[0], dout[1]) << "point " << point;
   }
 }
 
