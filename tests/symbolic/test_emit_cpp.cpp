@@ -58,26 +58,43 @@ class SharedObject {
   void* handle_ = nullptr;
 };
 
-TEST(EmitCpp, CompiledFunctionsAgreeWithTheInterpreter) {
+// A random list of 300 assignments emitted as one source: f, f_sens (along p[0] and p[2]) and
+// f_tangent (seeded on q and qd), with C linkage.
+struct RandomSource {
   Context ctx;
-  EquationList raw(ctx);
-  const auto model = testing::make_random_list(raw, 300, 6, 7);
-  const EquationList list = eliminate(raw);
-  const Direction dirs[2] = {along(ctx.element(model.p, 0)), along(ctx.element(model.p, 2))};
-  const EquationList sens = eliminate(differentiate(list, dirs));
-  const ArrayId seeded_arrays[2] = {model.q, model.qd};
-  const EquationList tangent = tangent_list(list, seeded_arrays);
+  testing::RandomModel model;
+  EquationList list{ctx}, sens{ctx}, tangent{ctx};
+  ArrayId seeded_arrays[2] = {0, 0};
+  std::string source;
 
-  EmitOptions options;
-  options.origin = "random list, seed 7";
-  options.extern_c = true;
-  options.function_name = "f";
-  std::vector<EmittedFunction> functions{emit_function(list, options)};
-  options.function_name = "f_sens";
-  functions.push_back(emit_function(sens, options));
-  options.function_name = "f_tangent";
-  functions.push_back(emit_tangent(tangent, seeded_arrays, options));
-  const std::string source = emit_source_file(functions, "", options);
+  explicit RandomSource(unsigned seed) {
+    EquationList raw(ctx);
+    model = testing::make_random_list(raw, 300, 6, seed);
+    list = eliminate(raw);
+    const Direction dirs[2] = {along(ctx.element(model.p, 0)), along(ctx.element(model.p, 2))};
+    sens = eliminate(differentiate(list, dirs));
+    seeded_arrays[0] = model.q;
+    seeded_arrays[1] = model.qd;
+    tangent = tangent_list(list, seeded_arrays);
+    EmitOptions options;
+    options.origin = "random list, seed " + std::to_string(seed);
+    options.extern_c = true;
+    options.function_name = "f";
+    std::vector<EmittedFunction> functions{emit_function(list, options)};
+    options.function_name = "f_sens";
+    functions.push_back(emit_function(sens, options));
+    options.function_name = "f_tangent";
+    functions.push_back(emit_tangent(tangent, seeded_arrays, options));
+    source = emit_source_file(functions, "", options);
+  }
+};
+
+TEST(EmitCpp, CompiledFunctionsAgreeWithTheInterpreter) {
+  RandomSource r(7);
+  Context& ctx = r.ctx;
+  const testing::RandomModel& model = r.model;
+  const EquationList &list = r.list, &sens = r.sens, &tangent = r.tangent;
+  const std::string& source = r.source;
   EXPECT_NE(source.find("noexcept"), std::string::npos);
   EXPECT_EQ(source.find("new "), std::string::npos);
 
@@ -135,20 +152,11 @@ TEST(EmitCpp, VectorClonesAgreeToTheBitWithABaselineBuild) {
   // the same source built with the attribute off runs the baseline code only. Both must give
   // the same numbers to the bit (no fused multiply-add in either), for plain functions and for
   // tangents in passes of two and one.
-  Context ctx;
-  EquationList raw(ctx);
-  const auto model = testing::make_random_list(raw, 300, 6, 11);
-  const EquationList list = eliminate(raw);
-  const ArrayId seeded_arrays[2] = {model.q, model.qd};
-  const EquationList tangent = tangent_list(list, seeded_arrays);
-  EmitOptions options;
-  options.origin = "random list, seed 11";
-  options.extern_c = true;
-  options.function_name = "f";
-  std::vector<EmittedFunction> functions{emit_function(list, options)};
-  options.function_name = "f_tangent";
-  functions.push_back(emit_tangent(tangent, seeded_arrays, options));
-  const std::string source = emit_source_file(functions, "", options);
+  RandomSource r(11);
+  Context& ctx = r.ctx;
+  const testing::RandomModel& model = r.model;
+  const EquationList& list = r.list;
+  const std::string& source = r.source;
   EXPECT_NE(source.find("target_clones(\"avx2\", \"default\")"), std::string::npos);
   const SharedObject cloned(source, "clones"), baseline(source, "baseline", "-DDYDP_VECTOR_CLONES=");
   ASSERT_TRUE(cloned.ok()) << cloned.log();
