@@ -32,22 +32,21 @@ ReducedDynamics::ReducedDynamics(const GeneratedModel& model) : model_(model), p
   }
   // B's structure from J's and Jv's blocks
   const int nu = this->nu(), n = model.n;
-  std::vector<std::vector<int>> block_u(jv_blocks_.blocks());
+  block_u_.assign(jv_blocks_.blocks(), {});
   std::vector<int> block_of_v(model.m, 0);
   for (int b = 0; b < jv_blocks_.blocks(); ++b) {
     for (int k : jv_blocks_.block_cols(b)) block_of_v[k] = b;
     for (int i = 0; i < nu; ++i) {
       bool reads = false;
       for (int row : jv_blocks_.block_rows(b)) reads = reads || model.jacobian_nonzero[row * n + u_[i]] != 0;
-      if (reads) block_u[b].push_back(i);
+      if (reads) block_u_[b].push_back(i);
     }
   }
-  block_u_ = block_u;
   b_cols_.resize(f_.size());
   free_row_of_.assign(n, -1);
   for (std::size_t a = 0; a < f_.size(); ++a) {
     free_row_of_[f_[a]] = static_cast<int>(a);
-    b_cols_[a] = free_place_[a] >= 0 ? std::vector<int>{free_place_[a]} : block_u[block_of_v[-1 - free_place_[a]]];
+    b_cols_[a] = free_place_[a] >= 0 ? std::vector<int>{free_place_[a]} : block_u_[block_of_v[-1 - free_place_[a]]];
   }
   row_of_v_.assign(model.m, -1);
   for (std::size_t a = 0; a < f_.size(); ++a) {

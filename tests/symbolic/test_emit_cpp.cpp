@@ -1,5 +1,6 @@
 // Emitted C++ is compiled by the project's compiler into a shared object, loaded, and run
-// against the interpreter on the same lists: plain functions, parameter derivatives, tangents.
+// against the interpreter on the same lists: plain functions, parameter derivatives, tangents;
+// and built with and without its vector clones, which must agree to the bit.
 #include "symbolic/emit_cpp.hpp"
 
 #include <dlfcn.h>
