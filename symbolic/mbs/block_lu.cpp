@@ -50,50 +50,120 @@ void BlockLU::set_pattern(const Eigen::Matrix<char, Eigen::Dynamic, Eigen::Dynam
     const std::size_t k = b.rows.size();
     b.lu.assign(k * k, 0.0);
     b.inverse.assign(k * k, 0.0);
-    b.pivot.assign(k, 0);
+    b.order.assign(k, 0);
+    b.reciprocal.assign(k, 0.0);
   }
 }
 
 namespace {
 
-// Doolittle's elimination with partial pivoting of a k x k column-major block in place, and the
-// substitution through its factors. K > 0 fixes k at compile time (the loops unroll: a corner's
-// blocks have four to six columns); K = 0 reads it at run time.
+// the block loops unrolled whole when k is known at compile time
+#define DYDP_UNROLL _Pragma("GCC unroll 8")
+
+// Doolittle's elimination with partial pivoting of a k x k column-major block in place, the
+// exchanges composed into one order and the pivots' reciprocals kept, and the substitution
+// through the factors. K > 0 fixes k at compile time (the loops unroll and the substitution's
+// vector stays in registers: a corner's blocks have four to six columns); K = 0 reads it at run
+// time.
 template <int K>
-bool factor_block(double* a, int* pivot, int k_run) {
+bool factor_block(double* __restrict a, int* __restrict order, double* __restrict reciprocal, int k_run) {
   const int k = K > 0 ? K : k_run;
   bool regular = true;
+  DYDP_UNROLL
+  for (int i = 0; i < k; ++i) order[i] = i;
+  DYDP_UNROLL
   for (int j = 0; j < k; ++j) {
     int p = j;
-    for (int i = j + 1; i < k; ++i)
-      if (std::abs(a[j * k + i]) > std::abs(a[j * k + p])) p = i;
-    pivot[j] = p;
-    if (p != j)
+    double largest = std::abs(a[j * k + j]);
+    DYDP_UNROLL
+    for (int i = j + 1; i < k; ++i) {
+      const double v = std::abs(a[j * k + i]);
+      p = v > largest ? i : p;
+      largest = v > largest ? v : largest;
+    }
+    if (p != j) {
+      DYDP_UNROLL
       for (int c = 0; c < k; ++c) std::swap(a[c * k + j], a[c * k + p]);
+      std::swap(order[j], order[p]);
+    }
     const double d = a[j * k + j];
+    const double r = 1.0 / d;
+    reciprocal[j] = r;
     if (d == 0.0 || !std::isfinite(d)) {
       regular = false;
       continue;
     }
-    for (int i = j + 1; i < k; ++i) a[j * k + i] /= d;
+    DYDP_UNROLL
+    for (int i = j + 1; i < k; ++i) a[j * k + i] *= r;
+    DYDP_UNROLL
     for (int c = j + 1; c < k; ++c) {
       const double f = a[c * k + j];
-      if (f == 0.0) continue;
+      DYDP_UNROLL
       for (int i = j + 1; i < k; ++i) a[c * k + i] -= a[j * k + i] * f;
     }
   }
   return regular;
 }
 
+// x := (P A_block)^-1 x, x holding the right-hand side in the factors' order (row i of the
+// block's right-hand side at x[j] where order[j] = i)
 template <int K>
-void substitute_block(const double* __restrict a, const int* pivot, double* __restrict z, int k_run) {
+inline void substitute_in_place(const double* __restrict a, const double* __restrict reciprocal, double* __restrict x,
+                                int k_run) {
   const int k = K > 0 ? K : k_run;
-  for (int j = 0; j < k; ++j) std::swap(z[j], z[pivot[j]]);  // P b
-  for (int j = 0; j < k; ++j)                                 // L y = P b
-    for (int i = j + 1; i < k; ++i) z[i] -= a[j * k + i] * z[j];
-  for (int j = k - 1; j >= 0; --j) {                          // U x = y
-    z[j] /= a[j * k + j];
-    for (int i = 0; i < j; ++i) z[i] -= a[j * k + i] * z[j];
+  DYDP_UNROLL
+  for (int j = 0; j < k; ++j)  // L y = P b
+    DYDP_UNROLL
+    for (int i = j + 1; i < k; ++i) x[i] -= a[j * k + i] * x[j];
+  DYDP_UNROLL
+  for (int j = k - 1; j >= 0; --j) {  // U x = y
+    x[j] *= reciprocal[j];
+    DYDP_UNROLL
+    for (int i = 0; i < j; ++i) x[i] -= a[j * k + i] * x[j];
+  }
+}
+
+// The same on z in memory, through a local copy when k is known (it stays in registers)
+template <int K>
+void substitute_block(const double* __restrict a, const double* __restrict reciprocal, double* __restrict z, int k_run) {
+  if constexpr (K > 0) {
+    double x[K];
+    DYDP_UNROLL
+    for (int i = 0; i < K; ++i) x[i] = z[i];
+    substitute_in_place<K>(a, reciprocal, x, K);
+    DYDP_UNROLL
+    for (int i = 0; i < K; ++i) z[i] = x[i];
+  } else {
+    substitute_in_place<K>(a, reciprocal, z, k_run);
+  }
+}
+
+// The block's inverse, row-major: column c is the substitution of the unit vector e_c, whose
+// 1 is, in the factors' order, where order[i] = c. When k is known the K columns are
+// substituted together, independent chains of multiply-adds; otherwise one by one in `column`
+// (k entries).
+template <int K>
+void invert_block(const double* __restrict a, const int* __restrict order, const double* __restrict reciprocal,
+                  double* __restrict inverse, double* __restrict column, int k_run) {
+  if constexpr (K > 0) {
+    double x[K][K];  // x[c]: column c
+    DYDP_UNROLL
+    for (int c = 0; c < K; ++c)
+      DYDP_UNROLL
+      for (int i = 0; i < K; ++i) x[c][i] = order[i] == c ? 1.0 : 0.0;
+    DYDP_UNROLL
+    for (int c = 0; c < K; ++c) substitute_in_place<K>(a, reciprocal, x[c], K);
+    DYDP_UNROLL
+    for (int i = 0; i < K; ++i)
+      DYDP_UNROLL
+      for (int c = 0; c < K; ++c) inverse[i * K + c] = x[c][i];
+  } else {
+    const int k = k_run;
+    for (int c = 0; c < k; ++c) {
+      for (int i = 0; i < k; ++i) column[i] = order[i] == c ? 1.0 : 0.0;
+      substitute_in_place<K>(a, reciprocal, column, k);
+      for (int i = 0; i < k; ++i) inverse[i * k + c] = column[i];
+    }
   }
 }
 
@@ -116,26 +186,25 @@ decltype(auto) with_block_size(int k, F f) {
 
 bool BlockLU::factor(Block& b) {
   const int k = static_cast<int>(b.rows.size());
-  return with_block_size(k, [&](auto K) { return factor_block<decltype(K)::value>(b.lu.data(), b.pivot.data(), k); });
+  return with_block_size(k, [&](auto K) {
+    return factor_block<decltype(K)::value>(b.lu.data(), b.order.data(), b.reciprocal.data(), k);
+  });
 }
 
 void BlockLU::apply_factors(const Block& b, double* z) {
   const int k = static_cast<int>(b.rows.size());
-  with_block_size(k, [&](auto K) { substitute_block<decltype(K)::value>(b.lu.data(), b.pivot.data(), z, k); });
+  with_block_size(k, [&](auto K) { substitute_block<decltype(K)::value>(b.lu.data(), b.reciprocal.data(), z, k); });
 }
 
 void BlockLU::invert() {
-  // The inverse (row-major), column by column of the identity through P, L and U: a block is
+  // The inverse (row-major) from the factors, all of a block's columns at once: a block is
   // solved for many right-hand sides per factorisation (the sedan: 14 columns of Ju, then the
   // tangents' directions), k^2 independent multiply-adds each instead of two substitutions.
-  double* z = work_.data();
   for (Block& b : blocks_) {
     const int k = static_cast<int>(b.rows.size());
-    for (int col = 0; col < k; ++col) {
-      for (int i = 0; i < k; ++i) z[i] = i == col ? 1.0 : 0.0;
-      apply_factors(b, z);
-      for (int i = 0; i < k; ++i) b.inverse[i * k + col] = z[i];
-    }
+    with_block_size(k, [&](auto K) {
+      invert_block<decltype(K)::value>(b.lu.data(), b.order.data(), b.reciprocal.data(), b.inverse.data(), work_.data(), k);
+    });
   }
   inverted_ = true;
 }
@@ -232,7 +301,7 @@ void BlockLU::substitute(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs,
     for (const Block& b : blocks_) {
       const int k = static_cast<int>(b.rows.size());
       double* z = t + size_;
-      for (int i = 0; i < k; ++i) z[i] = t[b.rows[i]];
+      for (int i = 0; i < k; ++i) z[i] = t[b.rows[b.order[i]]];  // in the factors' order
       apply_factors(b, z);
       for (int i = 0; i < k; ++i) xc[b.cols[i]] = z[i];
     }

@@ -49,7 +49,8 @@ class BlockLU {
   struct Block {
     std::vector<int> rows, cols;
     std::vector<double> lu;   // k x k, column-major: unit lower and upper factors of P A_block
-    std::vector<int> pivot;   // row exchanged with row i at elimination step i
+    std::vector<int> order;   // the row exchanges composed: row i of P A_block is row order[i] of A_block
+    std::vector<double> reciprocal;  // 1 / U(i, i)
     std::vector<double> inverse;  // k x k, row-major: block column c of x = sum over block rows
   };
   bool factor(Block& b);
@@ -57,7 +58,7 @@ class BlockLU {
   // entries among all blocks') and the block is factored.
   template <typename Fill>
   bool compute_from(Fill fill, const std::vector<int>& cols);
-  // z := A_block^-1 z through the factors (the block's exchanges, then L and U)
+  // z := A_block^-1 b through L and U, z holding b in the factors' order (z[i] = b[order[i]])
   static void apply_factors(const Block& b, double* z);
   void substitute(const double* b, Eigen::Index ldb, Eigen::Index nrhs, double* x, Eigen::Index ldx) const;
   bool inverted_ = false;
