@@ -46,8 +46,9 @@ int positive_integer(const BlockSettings& s, const char* name) {
 /// z_i = A_i sin(2 pi f_i t + phi_i) + a sum_k sin(2 pi f_k t + theta_ik), a = noise_rms sqrt(2 / N),
 /// f_k = f_lo + (k + 1/2)(f_hi - f_lo) / N: a noise of the given rms spread evenly over the band.
 /// With `input_file` set (dydp replay), the pads instead follow the recorded columns named in
-/// `pad_columns`, by cubic Hermite interpolation (displacement and rate continuous); recorded
-/// data has no parameters, so the tangents are zero.
+/// `pad_columns`, by a not-a-knot cubic spline (displacement, rate and acceleration continuous,
+/// so that the integrator's steps are not cut at every sample); recorded data has no
+/// parameters, so the tangents are zero.
 class FourPoster : public Block {
  public:
   enum { kNoiseRms = 12, kNoiseLow, kNoiseHigh };

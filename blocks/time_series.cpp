@@ -21,10 +21,44 @@ double TimeSeries::linear(double t) const {
   return (1 - w) * y_[k - 1] + w * y_[k];
 }
 
-double TimeSeries::slope(size_t k) const {
-  if (k == 0) return (y_[1] - y_[0]) / (t_[1] - t_[0]);
-  if (k == t_.size() - 1) return (y_[k] - y_[k - 1]) / (t_[k] - t_[k - 1]);
-  return (y_[k + 1] - y_[k - 1]) / (t_[k + 1] - t_[k - 1]);
+TimeSeries::TimeSeries(std::vector<double> t, std::vector<double> y)
+    : t_(std::move(t)), y_(std::move(y)), slope_(t_.size(), 0.0) {
+  // The slopes m_k of the cubic spline, from continuity of the second derivative at each
+  // interior sample, h_k m_{k-1} + 2 (h_{k-1} + h_k) m_k + h_{k-1} m_{k+1} = 3 (h_k d_{k-1} +
+  // h_{k-1} d_k) (h_k the intervals, d_k the chords' slopes), and at the ends the not-a-knot
+  // condition (the third derivative continuous at the second and the last but one sample; with
+  // fewer than four samples, zero curvature at the ends). A tridiagonal system, solved by
+  // elimination.
+  const size_t n = t_.size();
+  if (n < 2) return;
+  std::vector<double> h(n - 1), d(n - 1), lower(n, 0.0), diag(n), upper(n, 0.0), rhs(n);
+  for (size_t k = 0; k + 1 < n; ++k) {
+    h[k] = t_[k + 1] - t_[k];
+    d[k] = (y_[k + 1] - y_[k]) / h[k];
+  }
+  for (size_t k = 1; k + 1 < n; ++k) {
+    lower[k] = h[k];
+    diag[k] = 2.0 * (h[k - 1] + h[k]);
+    upper[k] = h[k - 1];
+    rhs[k] = 3.0 * (h[k] * d[k - 1] + h[k - 1] * d[k]);
+  }
+  if (n >= 4) {
+    const double left = h[0] + h[1], right = h[n - 3] + h[n - 2];
+    diag[0] = h[1], upper[0] = left;
+    rhs[0] = ((h[0] + 2.0 * left) * h[1] * d[0] + h[0] * h[0] * d[1]) / left;
+    lower[n - 1] = right, diag[n - 1] = h[n - 3];
+    rhs[n - 1] = (h[n - 2] * h[n - 2] * d[n - 3] + (2.0 * right + h[n - 2]) * h[n - 3] * d[n - 2]) / right;
+  } else {
+    diag[0] = 2.0, upper[0] = 1.0, rhs[0] = 3.0 * d[0];
+    lower[n - 1] = 1.0, diag[n - 1] = 2.0, rhs[n - 1] = 3.0 * d[n - 2];
+  }
+  for (size_t k = 1; k < n; ++k) {
+    const double f = lower[k] / diag[k - 1];
+    diag[k] -= f * upper[k - 1];
+    rhs[k] -= f * rhs[k - 1];
+  }
+  slope_[n - 1] = rhs[n - 1] / diag[n - 1];
+  for (size_t k = n - 1; k-- > 0;) slope_[k] = (rhs[k] - upper[k] * slope_[k + 1]) / diag[k];
 }
 
 void TimeSeries::cubic(double t, double& y, double& ydot) const {
@@ -35,7 +69,7 @@ void TimeSeries::cubic(double t, double& y, double& ydot) const {
   }
   const size_t k = segment(t);
   const double h = t_[k] - t_[k - 1], s = (t - t_[k - 1]) / h;
-  const double m0 = slope(k - 1) * h, m1 = slope(k) * h;
+  const double m0 = slope_[k - 1] * h, m1 = slope_[k] * h;
   const double s2 = s * s, s3 = s2 * s;
   y = (2 * s3 - 3 * s2 + 1) * y_[k - 1] + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * y_[k] + (s3 - s2) * m1;
   ydot = ((6 * s2 - 6 * s) * y_[k - 1] + (3 * s2 - 4 * s + 1) * m0 + (-6 * s2 + 6 * s) * y_[k] + (3 * s2 - 2 * s) * m1) / h;

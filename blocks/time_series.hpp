@@ -1,7 +1,7 @@
 // Recorded signals against time for source blocks (tables, steering records, shaker pads):
 // read from a recording (CSV or RPC III, engine/recording.hpp) named in the block's settings,
-// interpolated linearly or by cubic Hermite segments (value and slope continuous: a recorded
-// displacement and its rate).
+// interpolated linearly or by a cubic spline (value, slope and curvature continuous: a recorded
+// displacement, its rate and its acceleration).
 #pragma once
 
 #include <optional>
@@ -15,20 +15,21 @@ namespace dydp::blocks {
 class TimeSeries {
  public:
   TimeSeries() = default;
-  TimeSeries(std::vector<double> t, std::vector<double> y) : t_(std::move(t)), y_(std::move(y)) {}
+  TimeSeries(std::vector<double> t, std::vector<double> y);
 
   /// Linear interpolation, held constant outside the samples.
   double linear(double t) const;
-  /// Cubic Hermite interpolation with central-difference slopes (one-sided at the ends), held
-  /// constant outside; value and rate.
+  /// Cubic spline through the samples (twice continuously differentiable, not-a-knot ends:
+  /// exact for a cubic), held constant outside; value and rate.
   void cubic(double t, double& y, double& ydot) const;
   const std::vector<double>& times() const { return t_; }
   const std::vector<double>& values() const { return y_; }
 
  private:
   size_t segment(double t) const;
-  double slope(size_t k) const;
   std::vector<double> t_, y_;
+  std::vector<double> slope_;  // the spline's slope at each sample
+
 };
 
 /// Why a recording does not cover the run [t_start, t_stop] (it starts late or ends early, and

@@ -116,11 +116,11 @@ TEST_F(ReplayValues, ReplayFollowsTheRecordingNotTheRig) {
   const std::vector<double>& t = column(replayed, "t");
   ASSERT_EQ(t.size(), 1501u);
 
-  // The pads between samples against the sines themselves. Inside the recording the slopes are
-  // central differences (error (w h)^2 / 6 of A w) and the Hermite cubic is within about
-  // (w h)^3 / 40 of the sine: 1.2e-5 of the amplitude at 3.1 Hz (a linear interpolation would
-  // be (w h)^2 / 8 = 7.6e-4 off). In the first and last interval the slope is one-sided
-  // (error (w h) / 2 of A w): up to (w h)^2 / 2 x 4 / 27 = 4.5e-4.
+  // The pads between samples against the sines themselves. The recording is interpolated by a
+  // not-a-knot cubic spline, within about (w h)^4 x 5 / 384 of a sine: 4.8e-7 of the amplitude
+  // at 3.1 Hz sampled at 250 Hz (SciPy's CubicSpline on the same samples: 3.5e-7 inside, 8.9e-7
+  // in the first and last interval). The central-difference Hermite cubic it replaced was
+  // 1.2e-5 off inside and 4.5e-4 at the ends; a linear interpolation (w h)^2 / 8 = 7.6e-4.
   for (const auto& [signal, pad] : {std::pair{"pad_fl.y", kFrontLeft}, std::pair{"pad_rr.y", kRearRight}}) {
     const std::vector<double>& y = column(replayed, signal);
     double inside = 0, ends = 0;
@@ -129,8 +129,8 @@ TEST_F(ReplayValues, ReplayFollowsTheRecordingNotTheRig) {
       double& worst = t[k] <= 0.004 || t[k] >= 2.996 ? ends : inside;
       worst = std::max(worst, error);
     }
-    EXPECT_LT(inside, 1e-4) << signal;
-    EXPECT_LT(ends, 1e-3) << signal;
+    EXPECT_LT(inside, 1e-6) << signal;
+    EXPECT_LT(ends, 3e-6) << signal;
   }
 
   // The responses and their sensitivities against the sines' own run on the replay's grid.
