@@ -27,6 +27,7 @@
 #include "engine/jacobian_colouring.hpp"
 #include "engine/timeline.hpp"
 #include "engine/recorder.hpp"
+#include "engine/scene_relations.hpp"
 #include "engine/step_limiters.hpp"
 #include "engine/tolerances.hpp"
 
@@ -257,6 +258,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   check(CVodeSetMaxNumSteps(S.mem, d.solver.max_steps), "CVodeSetMaxNumSteps");
   check(CVodeSetMinStep(S.mem, d.solver.min_step), "CVodeSetMinStep");
   check(CVodeSetNonlinConvCoef(S.mem, d.solver.newton_coefficient), "CVodeSetNonlinConvCoef");
+  if (d.solver.max_order > 0) check(CVodeSetMaxOrd(S.mem, d.solver.max_order), "CVodeSetMaxOrd");
   if (bdf) {
     S.A = SUNDenseMatrix(n_cv, n_cv, S.ctx);
     use_compiled_matrix_kernels(S.A);
@@ -396,6 +398,10 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
       if (nx + nq > 0 && CVodeGetEstLocalErrors(S.mem, local_errors) == CV_SUCCESS &&
           CVodeGetErrWeights(S.mem, weights) == CV_SUCCESS)
         limiters.add_step(NV_DATA_S(local_errors), NV_DATA_S(weights));
+      if (int order = 0; CVodeGetLastOrder(S.mem, &order) == CV_SUCCESS && order >= 1) {
+        if (st.steps_per_order.size() < static_cast<size_t>(order)) st.steps_per_order.resize(order, 0);
+        ++st.steps_per_order[order - 1];
+      }
       at_target = reached == target;
     }
     // Otherwise the last step went past target, in this interval or an earlier one (it may have
@@ -431,6 +437,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
 
   st.rtol = d.solver.rtol;
   st.atol = d.solver.atol;
+  st.max_order = d.solver.max_order > 0 ? d.solver.max_order : highest_order(d.solver.method);
   finish_stats(st, d.solver.method, clock.seconds(), d.time);
   return result;
 }

@@ -40,6 +40,11 @@ struct SolverSpec {
   /// tolerance (CVODES' nonlinear convergence coefficient, its default 0.1). A larger value
   /// stops the iteration sooner and declares fewer convergence failures (each costs a Jacobian).
   double newton_coefficient = 0.1;
+  /// BDF and Adams: the highest order the integrator may use (BDF at most 5, Adams at most 12);
+  /// 0: the method's own limit. BDF's orders 4 and 5 are stable on a narrower wedge around the
+  /// imaginary axis: on lightly damped fast modes (a wheel on its tyre, oil columns) at loose
+  /// tolerances they fail the error test where order 3 does not (docs/accuracy.md).
+  int max_order = 0;
   /// BDF: the blocks' own diagonal blocks of the Newton matrix (Block::local_jacobian, the
   /// dampers' pressures) refreshed at each set-up, with a set-up every 5 steps; false: CVODES'
   /// own (the kept Jacobian as it is, a set-up every 20 steps).

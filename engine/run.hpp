@@ -50,6 +50,10 @@ struct RunStats {
   double simulated_seconds = 0.0;
   double realtime_factor = 0.0;   ///< simulated seconds per CPU second
   std::vector<std::string> warnings;
+  /// BDF and Adams: the highest order allowed (solver.max_order, else the method's own limit);
+  /// steps_per_order[k - 1] counts the accepted steps taken at order k.
+  int max_order = 0;
+  std::vector<long> steps_per_order;
   /// Variable-step solvers: the states that limited the step most often, most often first.
   std::vector<LimitingState> limiting_states;
 };

@@ -78,7 +78,7 @@ void read_solver(const SceneReader& r, const YAML::Node& n, const TimeSpec& time
   if (!n) return check_solver_relations(r.file(), n, s, time);
   r.allow_keys(n, "solver",
                {"method", "rtol", "atol", "step", "max_steps", "min_step", "sens_error_test", "nominal_scaling",
-                "newton_coefficient", "refresh_local_jacobians"});
+                "newton_coefficient", "refresh_local_jacobians", "max_order"});
   if (n["method"]) {
     s.method = r.text(n["method"], "solver.method");
     if (s.method != "bdf" && s.method != "adams" && s.method != "rk4" && s.method != "sdirk2" &&
@@ -109,6 +109,12 @@ void read_solver(const SceneReader& r, const YAML::Node& n, const TimeSpec& time
       r.fail(n["max_steps"], "solver.max_steps",
              "value " + n["max_steps"].Scalar() + " must be a whole number in [1, " + format_number(kMaxStepLimit) + "]");
     s.max_steps = static_cast<long>(v);
+  }
+  if (n["max_order"]) {
+    const double v = r.number(n["max_order"], "solver.max_order");
+    if (!(v >= 1 && v <= 12 && v == std::floor(v)))
+      r.fail(n["max_order"], "solver.max_order", "value " + n["max_order"].Scalar() + " must be a whole number in [1, 12]");
+    s.max_order = static_cast<int>(v);
   }
   if (n["min_step"]) s.min_step = r.number(n["min_step"], "solver.min_step");
   if (n["newton_coefficient"]) s.newton_coefficient = r.number(n["newton_coefficient"], "solver.newton_coefficient");

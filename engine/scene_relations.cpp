@@ -19,6 +19,12 @@ bool written(const YAML::Node& section, const char* key) { return section && sec
 
 }  // namespace
 
+int highest_order(const std::string& method) {
+  if (method == "bdf") return 5;
+  if (method == "adams") return 12;
+  return 0;
+}
+
 void check_time_relations(const std::string& file, const YAML::Node& section, const TimeSpec& time) {
   const auto fail = [&](const char* key, const std::string& message) {
     throw InputError(file, line_of(section, key), std::string("time.") + key, message);
@@ -54,6 +60,14 @@ void check_solver_relations(const std::string& file, const YAML::Node& section,
     if (!(span / solver.step <= kMaxFixedSteps))
       fail("step", "gives " + format_number(span / solver.step) + " steps, more than " +
                        format_number(kMaxFixedSteps));
+  }
+  if (written(section, "max_order")) {
+    const int top = highest_order(solver.method);
+    if (top == 0)
+      fail("max_order", "applies to bdf and adams only (method " + solver.method + " has a fixed scheme)");
+    if (!(solver.max_order >= 1 && solver.max_order <= top))
+      fail("max_order", "value " + std::to_string(solver.max_order) + " must be a whole number in [1, " +
+                            std::to_string(top) + "] for " + solver.method);
   }
   if (!(solver.min_step < time.output_step))
     fail("min_step", "value " + format_number(solver.min_step) + " s must be below time.output_step (" +

@@ -17,6 +17,10 @@ inline constexpr double kMaxOutputIntervals = 1e7;   ///< output grid intervals
 inline constexpr double kMaxFixedSteps = 1e9;        ///< fixed-step methods: steps per run
 inline constexpr double kMaxStepLimit = 1e9;         ///< solver.max_steps
 
+/// The highest order `method` can take (BDF 5, Adams 12); 0 for the fixed-step methods, which
+/// have no order to set.
+int highest_order(const std::string& method);
+
 /// `section`: the scene's `time:` node (may be undefined: defaults). Throws InputError at the
 /// line of the offending value.
 void check_time_relations(const std::string& file, const YAML::Node& section, const TimeSpec& time);

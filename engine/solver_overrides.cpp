@@ -35,6 +35,17 @@ void apply_solver_overrides(Diagram& d, const SolverOverrides& o) {
                          format_number(kMaxFixedSteps));
     d.solver.step = *o.step;
   }
+  if (o.max_order) {
+    const int top = highest_order(d.solver.method);
+    if (top == 0) fail("--max-order", "applies to bdf and adams only (method " + d.solver.method + ")");
+    if (!(*o.max_order >= 1 && *o.max_order <= top))
+      fail("--max-order", "value " + std::to_string(*o.max_order) + " must be in [1, " + std::to_string(top) +
+                              "] for " + d.solver.method);
+    d.solver.max_order = *o.max_order;
+  } else if (const int top = highest_order(d.solver.method); top > 0 && d.solver.max_order > top) {
+    fail("--solver", "the scene's solver.max_order " + std::to_string(d.solver.max_order) + " is beyond " +
+                         d.solver.method + "'s highest order " + std::to_string(top) + ": add --max-order");
+  }
 }
 
 }  // namespace dydp::engine

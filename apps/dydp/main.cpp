@@ -13,13 +13,15 @@
 
 namespace {
 
-/// --solver, --rtol, --atol, --step over the scene's solver section.
+/// --solver, --rtol, --atol, --step, --max-order over the scene's solver section.
 void add_solver_options(CLI::App* command, dydp::engine::SolverOverrides& o) {
   command->add_option("--solver", o.method, "integrator instead of the scene's (bdf adams rk4 sdirk2 rosw)");
   command->add_option_function<double>("--rtol", [&o](const double& v) { o.rtol = v; }, "relative tolerance");
   command->add_option_function<double>(
       "--atol", [&o](const double& v) { o.atol = v; }, "absolute tolerance, times each state's nominal magnitude");
   command->add_option_function<double>("--step", [&o](const double& v) { o.step = v; }, "fixed step [s]");
+  command->add_option_function<int>(
+      "--max-order", [&o](const int& v) { o.max_order = v; }, "highest order of bdf (1-5) or adams (1-12)");
 }
 
 }  // namespace

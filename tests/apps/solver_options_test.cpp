@@ -41,20 +41,21 @@ TEST_F(SolverOptions, RunWithOptionsIsTheRunOfTheEditedScene) {
   for (const Case& c : {Case{"--solver rk4 --step 0.002", "solver: {method: rk4, step: 0.002}"},
                         Case{"--rtol 1e-4 --atol 1e-6", "solver: {method: bdf, rtol: 1.0e-4, atol: 1.0e-6}"},
                         Case{"--solver sdirk2 --step 0.005", "solver: {method: sdirk2, step: 0.005}"},
-                        Case{"--solver adams --rtol 1e-5", "solver: {method: adams, rtol: 1.0e-5, atol: 1.0e-10}"}}) {
+                        Case{"--solver adams --rtol 1e-5", "solver: {method: adams, rtol: 1.0e-5, atol: 1.0e-10}"},
+                        Case{"--max-order 2", "solver: {method: bdf, rtol: 1.0e-8, atol: 1.0e-10, max_order: 2}"}}) {
     const fs::path a = dir_ / "a", b = dir_ / "b";
     const auto ra = dydp("run " + quote(msd_path()) + " " + c.options + " --out " + quote(a.string()));
     ASSERT_EQ(ra.status, 0) << c.options << ": " << ra.err;
     const auto rb = dydp("run " + quote(msd_with(c.solver)) + " --out " + quote(b.string()));
     ASSERT_EQ(rb.status, 0) << c.solver << ": " << rb.err;
     const json ja = run_json(a), jb = run_json(b);
-    for (const char* key : {"solver", "rtol", "atol", "fixed_step", "steps", "rhs_evaluations"})
+    for (const char* key : {"solver", "rtol", "atol", "fixed_step", "max_order", "steps", "rhs_evaluations"})
       EXPECT_EQ(ja[key], jb[key]) << c.options << ": " << key;
     EXPECT_EQ(read_text(a / "signals.csv"), read_text(b / "signals.csv")) << c.options;
     EXPECT_EQ(read_text(a / "objectives.json"), read_text(b / "objectives.json")) << c.options;
     // and it is not the scene's own setting (the options did something)
     EXPECT_NE(ja["steps"], 0);
-    EXPECT_TRUE(ja["solver"] != "bdf" || ja["rtol"] != 1e-8) << c.options;
+    EXPECT_TRUE(ja["solver"] != "bdf" || ja["rtol"] != 1e-8 || ja["max_order"] != 5) << c.options;
   }
 }
 
@@ -104,7 +105,9 @@ TEST_F(SolverOptions, ValuesTheSceneWouldRefuseAreRefused) {
                         Case{"--rtol 1", "--rtol: value 1 must be in (0, 1)"},
                         Case{"--atol -1e-9", "--atol: value -1e-09 must be in (0, 1)"},
                         Case{"--step 0", "--step: value 0 must be positive"},
-                        Case{"--step 1e-12", "--step: gives 1e+13 steps, more than 1e+09"}}) {
+                        Case{"--step 1e-12", "--step: gives 1e+13 steps, more than 1e+09"},
+                        Case{"--max-order 6", "--max-order: value 6 must be in [1, 5] for bdf"},
+                        Case{"--solver rk4 --max-order 2", "--max-order: applies to bdf and adams only"}}) {
     for (const std::string command : {"run", "accuracy"}) {
       const fs::path out = dir_ / "out";
       const auto r = dydp(command + " " + quote(msd_path()) + " " + c.options + " --out " + quote(out.string()));

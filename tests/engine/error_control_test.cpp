@@ -9,10 +9,13 @@
 // the fast one sets the step until the slow one's tolerance is made far tighter.
 #include <gtest/gtest.h>
 
+#include <numeric>
+
 #include <cmath>
 
 #include <fstream>
 #include <iterator>
+#include <numeric>
 #include <string>
 
 #include "engine/diagram.hpp"
@@ -213,6 +216,30 @@ TEST_F(ErrorControl, ALargerNewtonCoefficientReachesCvodesAndStopsTheIterationSo
             static_cast<double>(a.stats.nonlinear_iterations) / a.stats.steps);
   EXPECT_LE(b.stats.nonlinear_failures, a.stats.nonlinear_failures);
   EXPECT_NE(run_json(loose, b).find("\"newton_coefficient\": 0.5"), std::string::npos);
+}
+
+TEST_F(ErrorControl, AMaximumOrderReachesCvodesAndStepsAreCountedByOrder) {
+  // The quarter car with its CDC damper: unbounded, BDF climbs past order 2 for most steps;
+  // with solver.max_order 2 no step is taken above it. The counts by order add up to the steps.
+  const std::string scenes = std::string(DYDP_SOURCE_DIR) + "/scenarios/";
+  Diagram free = load_scene(scenes + "quarter_car_cdc.yaml");
+  Diagram capped = load_scene(scenes + "quarter_car_cdc.yaml");
+  free.time.stop = capped.time.stop = 1.0;
+  capped.solver.max_order = 2;
+  RunOptions options;
+  options.sensitivities = false;
+  const RunResult a = run(free, options), b = run(capped, options);
+  const auto total = [](const std::vector<long>& v) { return std::accumulate(v.begin(), v.end(), 0L); };
+  EXPECT_EQ(a.stats.max_order, 5);
+  EXPECT_EQ(total(a.stats.steps_per_order), a.stats.steps);
+  ASSERT_GT(a.stats.steps_per_order.size(), 2u);
+  EXPECT_GT(total(a.stats.steps_per_order) - a.stats.steps_per_order[0] - a.stats.steps_per_order[1],
+            a.stats.steps / 2);
+  EXPECT_EQ(b.stats.max_order, 2);
+  EXPECT_LE(b.stats.steps_per_order.size(), 2u);
+  EXPECT_EQ(total(b.stats.steps_per_order), b.stats.steps);
+  EXPECT_GT(b.stats.steps, a.stats.steps);  // second order needs more steps at the same tolerances
+  EXPECT_NE(run_json(capped, b).find("\"max_order\": 2"), std::string::npos);
 }
 
 TEST_F(ErrorControl, RefreshingTheDampersBlocksCutsNewtonFailuresAndKeepsTheSolution) {

@@ -615,6 +615,26 @@ TEST_F(SceneValidation, NewtonCoefficientOutsideTheUnitInterval) {
   }
 }
 
+TEST_F(SceneValidation, MaxOrderIsAnOrderTheMethodHas) {
+  struct Case {
+    std::string setting, message;
+  };
+  for (const Case& c : {Case{"max_order: 0", "value 0 must be a whole number in [1, 12]"},
+                        Case{"max_order: 2.5", "value 2.5 must be a whole number in [1, 12]"},
+                        Case{"max_order: 13", "value 13 must be a whole number in [1, 12]"},
+                        Case{"max_order: 6", "value 6 must be a whole number in [1, 5] for bdf"}}) {
+    const std::string path = write("s.yaml", scene_with_solver_setting(c.setting));
+    expect_error(load_error(path), path, 5, "solver.max_order", c.message);
+  }
+  std::string fixed = scene_with_solver_setting("max_order: 2");
+  fixed.replace(fixed.find("method: bdf"), 11, "method: rk4");
+  const std::string path = write("s.yaml", fixed);
+  expect_error(load_error(path), path, 5, "solver.max_order", "applies to bdf and adams only");
+  std::string adams = scene_with_solver_setting("max_order: 8");
+  adams.replace(adams.find("method: bdf"), 11, "method: adams");
+  EXPECT_EQ(load_scene(write("a.yaml", adams)).solver.max_order, 8);
+}
+
 TEST_F(SceneValidation, SolverSwitchesAreTrueOrFalse) {
   for (const char* key : {"sens_error_test", "nominal_scaling", "refresh_local_jacobians"}) {
     const std::string path = write("s.yaml", scene_with_solver_setting(std::string(key) + ": maybe"));
