@@ -370,10 +370,12 @@ std::string one_line(std::string s) {
   return s;
 }
 
-// Depth first over the nodes reachable from the list's assignments and outputs (from `first`
-// on), each once; visit(n) returns whether to go on into n's children.
+// Depth first over the nodes reachable from the list's assignments [first_assignment,
+// end_assignment) and outputs [first_output, end_output), each once; visit(n) returns whether to
+// go on into n's children.
 template <typename Visit>
-void walk_list(const EquationList& list, std::size_t first_assignment, std::size_t first_output, Visit visit) {
+void walk_range(const EquationList& list, std::size_t first_assignment, std::size_t end_assignment,
+                std::size_t first_output, std::size_t end_output, Visit visit) {
   const Context& ctx = list.context();
   std::vector<char> seen(ctx.size(), 0);
   std::vector<NodeId> stack;
@@ -388,8 +390,14 @@ void walk_list(const EquationList& list, std::size_t first_assignment, std::size
       for (NodeId c : ctx.children(n)) stack.push_back(c);
     }
   };
-  for (std::size_t i = first_assignment; i < list.size(); ++i) walk(list.assignments()[i].value);
-  for (std::size_t j = first_output; j < list.outputs().size(); ++j) walk(list.outputs()[j].value);
+  for (std::size_t i = first_assignment; i < end_assignment; ++i) walk(list.assignments()[i].value);
+  for (std::size_t j = first_output; j < end_output; ++j) walk(list.outputs()[j].value);
+}
+
+// The same from `first` to the end of the list.
+template <typename Visit>
+void walk_list(const EquationList& list, std::size_t first_assignment, std::size_t first_output, Visit visit) {
+  walk_range(list, first_assignment, list.size(), first_output, list.outputs().size(), visit);
 }
 
 // Abbreviations (S3, C3) the list reads, in node order.
@@ -411,14 +419,16 @@ std::vector<NodeId> abbreviations_used(const EquationList& list) {
 }
 
 // The primal values (primal auxiliaries, sines and cosines, input and parameter elements) that a
-// tangent list's derivative part reads as arithmetic operands, each with its name as a pair
-// (`lane_RJ12_8`); conditions (select, sign) and function arguments are not entered.
-std::unordered_map<NodeId, std::string> primal_values_read(const EquationList& tangent) {
+// derivative part (the block's assignments and outputs) reads as arithmetic operands, each with
+// its name as a pair (`lane_RJ12_8`); conditions (select, sign) and function arguments are not
+// entered.
+std::unordered_map<NodeId, std::string> primal_values_read(const EquationList& tangent, const TangentBlock& block) {
   const Context& ctx = tangent.context();
   std::vector<char> primal(ctx.size(), 0);
   for (std::size_t i = 0; i < tangent.primal_assignments(); ++i) primal[tangent.assignments()[i].target] = 1;
   std::unordered_map<NodeId, std::string> names;
-  walk_list(tangent, tangent.primal_assignments(), tangent.primal_outputs(), [&](NodeId x) {
+  walk_range(tangent, block.assignments_begin, block.assignments_end, block.outputs_begin, block.outputs_end,
+             [&](NodeId x) {
     const Op op = ctx.op(x);
     if (ctx.is_abbreviation(x)) {
       names.emplace(x, "lane_" + ctx.abbreviation_name(x));
@@ -562,49 +572,31 @@ EmittedFunction emit_function(const EquationList& list, const EmitOptions& optio
   return EmittedFunction{options.function_name, wrapped_signature(signature) + ";\n", body};
 }
 
-EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayId> seeded_arrays,
-                             const EmitOptions& options) {
-  if (!tangent.has_split()) throw std::invalid_argument("symbolic: emit_tangent needs a list from tangent_list");
-  check_size(tangent, options);
-  Context& ctx = tangent.context();
+namespace {
+
+// A derivative part: its directions d = first .. first + count - 1 (C++ expressions), two at a
+// time on pairs (Lanes, one SSE2 register), so that a direction costs about half the
+// instructions. The primal values it reads are broadcast to both lanes once before the loop:
+// read in the loop as a pair from memory, not loaded and unpacked once per pass. An odd last
+// direction (a sensitivity pass has one) runs the same derivative code once more on plain
+// doubles (One, OneSeed), reading the primal values as they are: with one direction, nothing is
+// broadcast. Seed (i, d) of array x at seed_x[d*size + i], derivative (j, d) at dout[d*k + j].
+void write_block(const EquationList& tangent, const TangentBlock& block, const std::string& count,
+                 const std::string& first, const std::string& indent, std::string& body) {
+  const Context& ctx = tangent.context();
   const Printer printer(ctx);
-  std::string seeds;
-  for (ArrayId a : seeded_arrays) seeds += "const double* seed_" + ctx.array(a).name + ", ";
-  const std::string signature = linkage(options) + "void " + options.function_name + "(" +
-                                input_parameters(ctx) + "int nd, " + seeds +
-                                "double* out, double* dout) noexcept";
-  const std::size_t primal_outputs = tangent.primal_outputs();
-  const std::size_t derivative_outputs = tangent.outputs().size() - primal_outputs;
-  std::string body = summary(tangent, options.function_name) +
-                     "// primal once, then the derivative part once per direction d < nd;\n"
-                     "// seed (i, d) at seed_x[d*n + i], derivative (j, d) at dout[d*" +
-                     std::to_string(derivative_outputs) + " + j]\n" + cloned_definition(signature, options) + "\n{\n";
-  write_prologue(tangent, printer, options, body);
-  write_assignments(tangent, printer, 0, tangent.primal_assignments(), "  ", body);
-  for (std::size_t j = 0; j < primal_outputs; ++j) {
-    const Output& o = tangent.outputs()[j];
-    body += "  out[" + std::to_string(j) + "] = ";
-    printer.print(o.value, body);
-    body += ";  // " + one_line(o.name) + "\n";
-  }
-  // Two directions per pass: the derivative part's arithmetic runs on pairs (Lanes, one SSE2
-  // register), so a direction costs about half the instructions. The primal values it reads
-  // are broadcast to both lanes once before the loop: read in the loop as a pair from memory,
-  // not loaded and unpacked once per pass. An odd last direction (a sensitivity pass has one)
-  // runs the same derivative code once more on plain doubles (One, OneSeed), reading the primal
-  // values as they are: with one direction, nothing is broadcast.
-  const std::unordered_map<NodeId, std::string> lane_names = primal_values_read(tangent);
+  const std::unordered_map<NodeId, std::string> lane_names = primal_values_read(tangent, block);
   std::vector<std::pair<NodeId, std::string>> sorted(lane_names.begin(), lane_names.end());
   std::sort(sorted.begin(), sorted.end());
   const Printer lane_printer(ctx, &lane_names);
-  const std::string k = std::to_string(derivative_outputs);
-  // the derivative part for either lane type, at `indent`
-  auto derivative_part = [&](const Printer& p, const std::string& indent) {
+  const std::string k = std::to_string(block.outputs_end - block.outputs_begin);
+  // the derivative part for either lane type, at `in`
+  auto derivative_part = [&](const Printer& p, const std::string& in) {
     std::string text;
-    write_assignments(tangent, p, tangent.primal_assignments(), tangent.size(), indent, text, "auto");
-    for (std::size_t j = 0; j < derivative_outputs; ++j) {
-      const Output& o = tangent.outputs()[primal_outputs + j];
-      text += indent + "store_lanes(dout_a, dout_b, " + std::to_string(j) + ", ";
+    write_assignments(tangent, p, block.assignments_begin, block.assignments_end, in, text, "auto");
+    for (std::size_t j = block.outputs_begin; j < block.outputs_end; ++j) {
+      const Output& o = tangent.outputs()[j];
+      text += in + "store_lanes(dout_a, dout_b, " + std::to_string(j - block.outputs_begin) + ", ";
       p.print(o.value, text);
       text += ");  // " + one_line(o.name) + "\n";
     }
@@ -612,35 +604,110 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
   };
   // each seed array as the pass reads it: `dq{seed_q + d*33, seed_q + (d + 1)*33}` for a pair,
   // `dq{seed_q + d*33}` for one direction
-  auto declare_seeds = [&](const std::string& type, bool pair, const std::string& indent) {
-    for (ArrayId a : seeded_arrays) {
-      const Array& seed = ctx.array(ctx.seed_array(a));
-      const std::string size = std::to_string(seed.elements.size()), from = "seed_" + ctx.array(a).name;
-      body += indent + "[[maybe_unused]] const " + type + " " + seed.name + "{" + from + " + d*" + size;
+  auto declare_seeds = [&](const std::string& type, bool pair, const std::string& in) {
+    for (const auto& [array, seed_array] : block.seeds) {
+      const Array& seed = ctx.array(seed_array);
+      const std::string size = std::to_string(seed.elements.size()), from = "seed_" + ctx.array(array).name;
+      body += in + "[[maybe_unused]] const " + type + " " + seed.name + "{" + from + " + d*" + size;
       if (pair) body += ", " + from + " + (d + 1)*" + size;
       body += "};\n";
     }
   };
-  body += "  if (nd >= 2) {\n";
+  const std::string end = first == "0" ? count : first + " + " + count;
+  body += indent + "if (" + count + " >= 2) {\n";
   for (const auto& [x, name] : sorted) {
-    body += "    const Lanes " + name + " = ";
+    body += indent + "  const Lanes " + name + " = ";
     printer.print(x, body);
     body += ";\n";
   }
-  body += "    for (int d = 0; d + 1 < nd; d += 2) {\n";
-  declare_seeds("LaneSeed", true, "      ");
-  body += "      double* const dout_a = dout + d*" + k + ";\n";
-  body += "      [[maybe_unused]] double* const dout_b = dout_a + " + k + ";\n";
-  body += derivative_part(lane_printer, "      ");
-  body += "    }\n";
-  body += "  }\n";
-  body += "  if (nd % 2 == 1) {\n";
-  body += "    const int d = nd - 1;\n";
-  declare_seeds("OneSeed", false, "    ");
-  body += "    double* const dout_a = dout + d*" + k + ";\n";
-  body += "    [[maybe_unused]] constexpr decltype(nullptr) dout_b = nullptr;\n";
-  body += derivative_part(printer, "    ");
-  body += "  }\n}\n";
+  body += indent + "  for (int d = " + first + "; d + 1 < " + end + "; d += 2) {\n";
+  declare_seeds("LaneSeed", true, indent + "    ");
+  body += indent + "    double* const dout_a = dout + d*" + k + ";\n";
+  body += indent + "    [[maybe_unused]] double* const dout_b = dout_a + " + k + ";\n";
+  body += derivative_part(lane_printer, indent + "    ");
+  body += indent + "  }\n";
+  body += indent + "}\n";
+  body += indent + "if (" + count + " % 2 == 1) {\n";
+  body += indent + "  const int d = " + end + " - 1;\n";
+  declare_seeds("OneSeed", false, indent + "  ");
+  body += indent + "  double* const dout_a = dout + d*" + k + ";\n";
+  body += indent + "  [[maybe_unused]] constexpr decltype(nullptr) dout_b = nullptr;\n";
+  body += derivative_part(printer, indent + "  ");
+  body += indent + "}\n";
+}
+
+// The prologue, the primal assignments and the primal outputs of a tangent list.
+void write_primal(const EquationList& tangent, const EmitOptions& options, std::string& body) {
+  const Printer printer(tangent.context());
+  write_prologue(tangent, printer, options, body);
+  write_assignments(tangent, printer, 0, tangent.primal_assignments(), "  ", body);
+  for (std::size_t j = 0; j < tangent.primal_outputs(); ++j) {
+    const Output& o = tangent.outputs()[j];
+    body += "  out[" + std::to_string(j) + "] = ";
+    printer.print(o.value, body);
+    body += ";  // " + one_line(o.name) + "\n";
+  }
+}
+
+std::string seed_parameters(const Context& ctx, std::span<const ArrayId> seeded_arrays) {
+  std::string seeds;
+  for (ArrayId a : seeded_arrays) seeds += "const double* seed_" + ctx.array(a).name + ", ";
+  return seeds;
+}
+
+}  // namespace
+
+EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayId> seeded_arrays,
+                             const EmitOptions& options) {
+  if (!tangent.has_split()) throw std::invalid_argument("symbolic: emit_tangent needs a list from tangent_list");
+  check_size(tangent, options);
+  Context& ctx = tangent.context();
+  const std::string signature = linkage(options) + "void " + options.function_name + "(" +
+                                input_parameters(ctx) + "int nd, " + seed_parameters(ctx, seeded_arrays) +
+                                "double* out, double* dout) noexcept";
+  TangentBlock block;
+  for (ArrayId a : seeded_arrays) block.seeds.emplace_back(a, ctx.seed_array(a));
+  block.assignments_begin = tangent.primal_assignments();
+  block.assignments_end = tangent.size();
+  block.outputs_begin = tangent.primal_outputs();
+  block.outputs_end = tangent.outputs().size();
+  std::string body = summary(tangent, options.function_name) +
+                     "// primal once, then the derivative part once per direction d < nd;\n"
+                     "// seed (i, d) at seed_x[d*n + i], derivative (j, d) at dout[d*" +
+                     std::to_string(block.outputs_end - block.outputs_begin) + " + j]\n" +
+                     cloned_definition(signature, options) + "\n{\n";
+  write_primal(tangent, options, body);
+  write_block(tangent, block, "nd", "0", "  ", body);
+  body += "}\n";
+  return EmittedFunction{options.function_name, wrapped_signature(signature) + ";\n", body, true};
+}
+
+EmittedFunction emit_grouped_tangent(const GroupedTangent& grouped, std::span<const ArrayId> seeded_arrays,
+                                     const EmitOptions& options) {
+  const EquationList& tangent = grouped.list;
+  check_size(tangent, options);
+  const Context& ctx = tangent.context();
+  const std::string signature = linkage(options) + "void " + options.function_name + "(" +
+                                input_parameters(ctx) + "const int* nd, " + seed_parameters(ctx, seeded_arrays) +
+                                "double* out, double* dout) noexcept";
+  std::string body = summary(tangent, options.function_name) +
+                     "// primal once, then each block's derivative part once per direction of that block:\n"
+                     "// nd[b] directions for block b, the blocks' directions one after the other;\n"
+                     "// seed (i, d) at seed_x[d*n + i], derivative (j, d) at dout[d*k + j]\n" +
+                     cloned_definition(signature, options) + "\n{\n";
+  write_primal(tangent, options, body);
+  body += "  int d0 = 0;\n";
+  for (std::size_t b = 0; b < grouped.blocks.size(); ++b) {
+    const TangentBlock& block = grouped.blocks[b];
+    std::string seeds;
+    for (const auto& [array, seed] : block.seeds) seeds += " " + ctx.array(array).name;
+    body += "  {  // block " + std::to_string(b) + ": " + one_line(block.label) + ", seeded on" + seeds + "\n";
+    body += "    const int nb = nd[" + std::to_string(b) + "];\n";
+    write_block(tangent, block, "nb", "d0", "    ", body);
+    body += "    d0 += nb;\n";
+    body += "  }\n";
+  }
+  body += "}\n";
   return EmittedFunction{options.function_name, wrapped_signature(signature) + ";\n", body, true};
 }
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "symbolic/equation_list.hpp"
+#include "symbolic/grouped_tangent.hpp"
 
 namespace dydp::symbolic {
 
@@ -49,6 +50,13 @@ EmittedFunction emit_function(const EquationList& list, const EmitOptions& optio
 // A tangent function; `tangent` comes from tangent_list(list, seeded_arrays) with the same arrays.
 EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayId> seeded_arrays,
                              const EmitOptions& options);
+
+// A tangent in blocks (grouped_tangent): the primal once, then each block's derivative part over
+// its own directions. As emit_tangent's, with `const int* nd` (nd[b] directions for block b, the
+// blocks' directions consecutive in the seed arrays and in dout) instead of `int nd`;
+// `seeded_arrays`: every array some block seeds, in the order of the seed arguments.
+EmittedFunction emit_grouped_tangent(const GroupedTangent& grouped, std::span<const ArrayId> seeded_arrays,
+                                     const EmitOptions& options);
 
 // The table function of EmitOptions::trig_table for an array of `size` elements: sin and cos of
 // every element, computed again only when the array differs from the previous call's on the same

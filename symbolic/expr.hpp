@@ -85,6 +85,9 @@ class Context {
                     std::vector<std::string> element_names = {});
   // The Seed array carrying directions for `array` (created on first call, named `d<name>`).
   ArrayId seed_array(ArrayId array);
+  // A further Seed array for `array` (named `d<name>_<suffix>`), for a tangent whose blocks
+  // each read seeds of their own (symbolic/grouped_tangent.hpp); seed_array keeps the first.
+  ArrayId add_seed_array(ArrayId array, std::string_view suffix);
   Expr element(ArrayId array, std::size_t index);
   const Array& array(ArrayId id) const { return arrays_.at(id); }
   std::size_t array_count() const { return arrays_.size(); }

@@ -11,6 +11,7 @@
 #include "symbolic/eliminate.hpp"
 #include "symbolic/emit_cpp.hpp"
 #include "symbolic/expand.hpp"
+#include "symbolic/grouped_tangent.hpp"
 #include "symbolic/mbs/model.hpp"
 #include "symbolic/mbs/newton_euler.hpp"
 #include "symbolic/mbs/numeric_dynamics.hpp"
@@ -106,6 +107,49 @@ std::vector<int> choose_independent(const mbs::Model& model, bool& automatic) {
   return u;
 }
 
+// J's structural nonzeros, m x n row-major: 0 where J is zero whatever the state.
+std::vector<int> jacobian_structure(const mbs::ModelLists& lists, int m, int n) {
+  const Context& ctx = lists.constraints->context();
+  std::vector<int> nonzero;
+  for (int k = 0; k < m * n; ++k) {
+    const NodeId v = lists.constraints->outputs()[m + k].value;
+    nonzero.push_back(!(ctx.op(v) == Op::Constant && ctx.value(v) == 0.0));
+  }
+  return nonzero;
+}
+
+// The coordinates that move together: those a constraint row couples (J's structure) are one
+// group, every other coordinate a group alone; driven coordinates are in none. The seeds of a
+// direction along an independent coordinate (dq = B du) stay inside its group.
+std::vector<std::vector<int>> coupled_coordinates(const mbs::Model& model, const std::vector<int>& nonzero) {
+  const int n = model.coordinates(), m = model.constraint_count();
+  std::vector<int> root(n);
+  for (int i = 0; i < n; ++i) root[i] = i;
+  const auto find = [&](int i) {
+    while (root[i] != i) i = root[i] = root[root[i]];
+    return i;
+  };
+  std::vector<bool> driven(n, false);
+  for (int j : model.driven_joints()) driven[j] = true;
+  for (int r = 0; r < m; ++r) {
+    int first = -1;
+    for (int c = 0; c < n; ++c) {
+      if (!nonzero[r * n + c] || driven[c]) continue;
+      if (first < 0) first = c;
+      else root[find(c)] = find(first);
+    }
+  }
+  std::vector<std::vector<int>> groups;
+  std::vector<int> group_of_root(n, -1);
+  for (int c = 0; c < n; ++c) {
+    if (driven[c]) continue;
+    int& g = group_of_root[find(c)];
+    if (g < 0) g = static_cast<int>(groups.size()), groups.emplace_back();
+    groups[g].push_back(c);
+  }
+  return groups;
+}
+
 // Whether a sensor's outputs depend on qdd: acceleration sensors, and joint sensors that report
 // the joint's acceleration.
 bool reads_acceleration(const mbs::Sensor& sensor) {
@@ -167,9 +211,9 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
     return result;
   }
 
-  // Five translation units, so that a large model's code compiles in parallel: dynamics (M and
-  // the residual), its tangent, its velocity tangent, kinematics (constraints), sensors and
-  // Jacobians.
+  // Six translation units, so that a large model's code compiles in parallel: dynamics (M and
+  // the residual), its tangent, its velocity tangent, its tangent in blocks (empty for a model
+  // without groups), kinematics (constraints), sensors and Jacobians.
   std::vector<EmittedFunction> dynamics, residual_tangent, kinematics, sensors;
   // sin and cos of the coordinates once per state, shared by every function below
   emit.trig_table = name + "_trig";
@@ -190,6 +234,60 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   std::vector<EmittedFunction> velocity_tangent;
   velocity_tangent.push_back(
       tangent(name + "_residual_velocity_tangent", *lists.residual, {lists.qd, lists.qdd, lists.inp, lists.p}));
+  // The residual's tangent in blocks (symbolic/grouped_tangent.hpp): a full block and a velocity
+  // block (as the two functions above), then for each group of coordinates that move together a
+  // position block (q, qd, qdd seeded in the group) and a velocity block (qd, qdd in the group),
+  // all after one primal. A group is kept when its position block costs at most half of the
+  // full one per direction; models without constraints have none (the groups of a chain are its
+  // single joints, whose blocks the full tangent serves).
+  const std::size_t n = model.coordinates(), m = model.constraint_count();
+  std::vector<EmittedFunction> tangent_groups_tu;  // its own file: the largest of the model's functions
+  const std::vector<int> jacobian_nonzero = jacobian_structure(lists, static_cast<int>(m), static_cast<int>(n));
+  std::vector<int> tangent_group(n, -1);
+  int tangent_groups = 0;
+  if (m > 0) {
+    auto specs_for = [&](const std::vector<std::vector<int>>& groups) {
+      std::vector<BlockSeeds> specs{{"full", {{lists.q, {}}, {lists.qd, {}}, {lists.qdd, {}}, {lists.inp, {}}, {lists.p, {}}}},
+                                    {"velocity", {{lists.qd, {}}, {lists.qdd, {}}, {lists.inp, {}}, {lists.p, {}}}}};
+      for (std::size_t g = 0; g < groups.size(); ++g) {
+        std::vector<std::uint32_t> e(groups[g].begin(), groups[g].end());
+        std::string names;
+        for (int c : groups[g]) names += (names.empty() ? "" : " ") + model.joints[c].name;
+        specs.push_back({"group " + std::to_string(g) + " position (" + names + ")", {{lists.q, e}, {lists.qd, e}, {lists.qdd, e}}});
+        specs.push_back({"group " + std::to_string(g) + " velocity (" + names + ")", {{lists.qd, e}, {lists.qdd, e}}});
+      }
+      return specs;
+    };
+    auto block_ops = [](const GroupedTangent& t, std::size_t b) {
+      const TangentBlock& block = t.blocks[b];
+      EquationList alone(t.list.context());
+      for (std::size_t k = block.assignments_begin; k < block.assignments_end; ++k) alone.append(t.list.assignments()[k]);
+      for (std::size_t k = block.outputs_begin; k < block.outputs_end; ++k) alone.add_output(t.list.outputs()[k]);
+      return count_ops(alone);
+    };
+    const std::vector<std::vector<int>> candidates = coupled_coordinates(model, jacobian_nonzero);
+    const GroupedTangent trial = grouped_tangent(*lists.residual, specs_for(candidates));
+    std::vector<std::vector<int>> kept;
+    for (std::size_t g = 0; g < candidates.size(); ++g)
+      if (2 * block_ops(trial, 2 + 2 * g).total() <= block_ops(trial, 0).total()) kept.push_back(candidates[g]);
+    if (!kept.empty()) {
+      const GroupedTangent grouped = grouped_tangent(*lists.residual, specs_for(kept));
+      const std::string fn = name + "_residual_tangent_groups";
+      emit.function_name = fn;
+      result.functions.push_back({fn, lists.residual->size(), grouped.list.size(), count_ops(grouped.list)});
+      // each block's operations per direction
+      for (std::size_t b = 0; b < grouped.blocks.size(); ++b) {
+        const std::size_t size = grouped.blocks[b].assignments_end - grouped.blocks[b].assignments_begin;
+        result.parts.push_back({fn + "." + grouped.blocks[b].label, size, size, block_ops(grouped, b)});
+      }
+      EmittedFunction f = emit_grouped_tangent(grouped, all_seeded, emit);
+      measure_text(f.definition, result.functions.back());
+      tangent_groups_tu.push_back(std::move(f));
+      tangent_groups = static_cast<int>(kept.size());
+      for (std::size_t g = 0; g < kept.size(); ++g)
+        for (int c : kept[g]) tangent_group[c] = static_cast<int>(g);
+    }
+  }
   auto part = [&](const std::string& label, const EquationList& list, std::size_t from, std::size_t to) {
     EquationList alone(list.context());
     for (const auto& a : list.assignments()) alone.append(a);
@@ -197,7 +295,6 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
     const EquationList c = compact(eliminate(alone));
     result.parts.push_back({label, list.size(), c.size(), count_ops(c)});
   };
-  const std::size_t n = model.coordinates(), m = model.constraint_count();
   part(name + "_residual.inverse_dynamics", *lists.applied, 0, n);
   part(name + "_residual.constraint_accelerations", *lists.applied, n, n + m);
   part(name + "_residual_tangent.primal_with_cut_forces", *lists.residual, 0, n);
@@ -235,7 +332,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   for (int j : independent) result.independent.push_back(model.joints[j].name);
 
   std::vector<EmittedFunction> all = dynamics;
-  for (const auto* part : {&residual_tangent, &velocity_tangent, &kinematics, &sensors})
+  for (const auto* part : {&residual_tangent, &velocity_tangent, &tangent_groups_tu, &kinematics, &sensors})
     all.insert(all.end(), part->begin(), part->end());
   const std::string header = name + ".hpp";
   std::string header_text = emit_header_file(all, emit);
@@ -245,6 +342,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   write_atomically(options.out_dir / (name + "_dynamics.cpp"), emit_source_file(dynamics, header, emit));
   write_atomically(options.out_dir / (name + "_residual_tangent.cpp"), emit_source_file(residual_tangent, header, emit));
   write_atomically(options.out_dir / (name + "_velocity_tangent.cpp"), emit_source_file(velocity_tangent, header, emit));
+  write_atomically(options.out_dir / (name + "_tangent_groups.cpp"), emit_source_file(tangent_groups_tu, header, emit));
   write_atomically(options.out_dir / (name + "_kinematics.cpp"), emit_source_file(kinematics, header, emit));
   write_atomically(options.out_dir / (name + "_sensors.cpp"), emit_source_file(sensors, header, emit));
 
@@ -294,16 +392,8 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += number_array("double", "initial_q", q0);
   d += number_array("int", "driven", driven);
   d += number_array("int", "independent", independent);
-  std::vector<int> jacobian_nonzero;
-  {
-    const Context& ctx = lists.constraints->context();
-    const int m = model.constraint_count(), n = model.coordinates();
-    for (int k = 0; k < m * n; ++k) {
-      const NodeId v = lists.constraints->outputs()[m + k].value;
-      jacobian_nonzero.push_back(!(ctx.op(v) == Op::Constant && ctx.value(v) == 0.0));
-    }
-  }
   d += number_array("int", "jacobian_nonzero", jacobian_nonzero);
+  d += number_array("int", "tangent_group", tangent_group);
   // the mass matrix's entries: (row, col) of each output of NAME_mass_matrix, read off its names
   std::vector<int> mass_rows, mass_cols;
   if (lists.mass_loops) mass_loops_entries(*lists.mass_loops, mass_rows, mass_cols);
@@ -331,7 +421,9 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   d += "    " + std::to_string(mass_rows.size()) + ", mass_rows, mass_cols, " +
        (lists.mass_matrix || lists.mass_loops ? name + "_mass_matrix" : std::string("nullptr")) + ",\n    parameter_units,\n";
   d += "    " + name + "_sensors_kinematic, " + name + "_sensors_kinematic_tangent, " + name + "_sensors_acceleration, " +
-       name + "_sensors_acceleration_tangent,\n    " + name + "_residual_velocity_tangent};\n\n";
+       name + "_sensors_acceleration_tangent,\n    " + name + "_residual_velocity_tangent,\n";
+  d += "    " + std::to_string(tangent_groups) + ", tangent_group, " +
+       (tangent_groups > 0 ? name + "_residual_tangent_groups" : std::string("nullptr")) + "};\n\n";
   d += "}  // namespace dydp::generated\n";
   write_atomically(options.out_dir / (name + "_model.cpp"), d);
   return result;

@@ -21,7 +21,8 @@ struct MbsGeneration {
   bool independent_automatic = false;
 };
 
-// Writes NAME.hpp, NAME_dynamics.cpp, NAME_kinematics.cpp and NAME_model.cpp into out_dir.
+// Writes NAME.hpp, NAME_dynamics.cpp, NAME_residual_tangent.cpp, NAME_velocity_tangent.cpp,
+// NAME_tangent_groups.cpp, NAME_kinematics.cpp, NAME_sensors.cpp and NAME_model.cpp into out_dir.
 // With `expand`, writes only the point Jacobians in extenso (NAME_expanded.hpp/.cpp): the other
 // functions' in-extenso forms are far too large to write.
 MbsGeneration generate_mbs(const std::string& model_path, const GenerationOptions& options);

@@ -21,6 +21,15 @@ using GeneratedVelocityTangent = void (*)(const double* q, const double* qd, con
                                           const double* inp, const double* p, int nd, const double* seed_qd,
                                           const double* seed_qdd, const double* seed_inp, const double* seed_p,
                                           double* out, double* dout);
+// The residual's tangent in blocks, after one primal (symbolic/grouped_tangent.hpp): nd[b]
+// directions for block b, the blocks' directions consecutive in the seeds and in dout, laid out
+// as in GeneratedTangent. Block 0 is seeded on every array (as GeneratedTangent), block 1 on
+// qd, qdd, inp and p (as GeneratedVelocityTangent); for each coordinate group g, block 2 + 2g
+// on q, qd and qdd in the group only, block 3 + 2g on qd and qdd in the group only.
+using GeneratedGroupedTangent = void (*)(const double* q, const double* qd, const double* qdd, const double* lam,
+                                         const double* inp, const double* p, const int* nd, const double* seed_q,
+                                         const double* seed_qd, const double* seed_qdd, const double* seed_inp,
+                                         const double* seed_p, double* out, double* dout);
 // Tangent seeded on qdd only (the inertial pass: columns of M); it writes no primal outputs
 // (`out` is not touched).
 using GeneratedMassTangent = void (*)(const double* q, const double* qd, const double* qdd, const double* lam,
@@ -87,6 +96,12 @@ struct GeneratedModel {
   // residual_tangent for directions with dq = 0: it computes only what the velocities, loads,
   // accelerations and parameters reach, none of the rotations' and positions' derivatives.
   GeneratedVelocityTangent residual_velocity_tangent;
+  // Groups of coordinates that move together (those a constraint row couples; the others alone)
+  // whose directions cost at most half a full one in residual_tangent_groups: tangent_group[i]
+  // is coordinate i's group or -1. Zero groups (and a null function) when none pays.
+  int tangent_groups;
+  const int* tangent_group;
+  GeneratedGroupedTangent residual_tangent_groups;
 };
 
 }  // namespace dydp::mbs

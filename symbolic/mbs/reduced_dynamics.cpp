@@ -433,12 +433,50 @@ void ReducedDynamics::put_directions(const std::vector<int>& cols, Result::Work&
   for (std::size_t c = 0; c < cols.size(); ++c) dout.col(cols[c]) = w.g_dout.col(static_cast<Eigen::Index>(c));
 }
 
+int ReducedDynamics::tangent_block(const Result::Work& w, int d, const Matrix& dq, const Matrix& dqd,
+                                   const Matrix& dqdd) const {
+  const int n = model_.n;
+  bool moves = false;
+  int group = -2;  // -2: no seed yet; -1: seeds outside any one group
+  for (const Matrix* seeds : {&dq, &dqd, &dqdd}) {
+    const double* col = seeds->data() + static_cast<Eigen::Index>(d) * n;
+    for (int i = 0; i < n && group != -1; ++i) {
+      if (col[i] == 0.0) continue;
+      moves = moves || seeds == &dq;
+      const int g = model_.tangent_group[i];
+      group = group == -2 || group == g ? g : -1;
+    }
+  }
+  const bool loads = !(w.dinp.col(d).array() == 0.0).all() || !(w.dp.col(d).array() == 0.0).all();
+  if (group >= 0 && !loads) return 2 + 2 * group + (moves ? 0 : 1);
+  // a direction without seeds is cheapest in any group's velocity block
+  if (group == -2 && !loads && model_.tangent_groups > 0) return 3;
+  return moves ? 0 : 1;
+}
+
 void ReducedDynamics::residual_tangent(const Result& r, const double* lam, const double* in, const double* p, int nd,
                                        const Matrix& dq, const Matrix& dqd, const Matrix& dqdd) const {
   Result::Work& w = r.work;
   const int n = model_.n, rows = n + model_.m;
   w.out.resize(rows);
   w.dout.resize(rows, nd);
+  if (model_.residual_tangent_groups) {
+    // each direction in its block, the blocks' directions consecutive (a counting sort)
+    const int blocks = 2 + 2 * model_.tangent_groups;
+    w.block.resize(nd);
+    w.order.resize(nd);
+    w.per_block.assign(2 * blocks, 0);
+    int* const count = w.per_block.data();
+    int* const next = count + blocks;  // where each block's next direction goes in order
+    for (int d = 0; d < nd; ++d) ++count[w.block[d] = tangent_block(w, d, dq, dqd, dqdd)];
+    for (int b = 1; b < blocks; ++b) next[b] = next[b - 1] + count[b - 1];
+    for (int d = 0; d < nd; ++d) w.order[next[w.block[d]]++] = d;
+    const DirectionSeeds s = directions(w.order, dq, dqd, dqdd, w.dout, w);
+    model_.residual_tangent_groups(r.q.data(), r.qd.data(), r.qdd.data(), lam, in, p, count, s.dq, s.dqd, s.dqdd,
+                                   s.dinp, s.dp, w.out.data(), s.dout);
+    put_directions(w.order, w, w.dout);
+    return;
+  }
   if (model_.residual_velocity_tangent) split_directions(dq, nullptr, nd, w.moving, w.still);
   if (!model_.residual_velocity_tangent || w.still.empty()) {
     model_.residual_tangent(r.q.data(), r.qd.data(), r.qdd.data(), lam, in, p, nd, dq.data(), dqd.data(),

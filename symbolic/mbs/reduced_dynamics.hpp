@@ -52,6 +52,9 @@ class ReducedDynamics {
       // directions that move the coordinates (dq != 0) and those that do not, and their seeds
       // gathered in that order when they are not already
       std::vector<int> moving, still;
+      // residual_tangent_groups: each direction's block, the directions in block order, and
+      // the number in each block
+      std::vector<int> block, order, per_block;
       Matrix g_dq, g_dqd, g_dqdd, g_dinp, g_dp, g_dout;
       const void* shaped_by = nullptr;  // the partitioning that last shaped B and MB
     };
@@ -123,10 +126,15 @@ class ReducedDynamics {
                                    const Matrix& dqdd, Matrix& dout, Result::Work& w);
   static void put_directions(const std::vector<int>& cols, Result::Work& w, Matrix& dout);
   // The residual's tangent (dr, da) into r.work.dout for the seeds dq, dqd, dqdd and
-  // r.work.dinp, dp: the directions with dq = 0 through the model's velocity tangent, which
-  // skips every derivative of the rotations and positions.
+  // r.work.dinp, dp: through the model's tangent in blocks when it has one (each direction in
+  // the cheapest block its seeds fit), else the directions with dq = 0 through the model's
+  // velocity tangent, which skips every derivative of the rotations and positions.
   void residual_tangent(const Result& r, const double* lam, const double* in, const double* p, int nd,
                         const Matrix& dq, const Matrix& dqd, const Matrix& dqdd) const;
+  // The block of residual_tangent_groups for direction d (GeneratedGroupedTangent's numbering):
+  // a coordinate group's when every seed it has on q, qd and qdd lies in that group and it has
+  // none on the inputs and parameters; the full or the velocity block otherwise.
+  int tangent_block(const Result::Work& w, int d, const Matrix& dq, const Matrix& dqd, const Matrix& dqdd) const;
   // Row a of the free coordinates: its place among u (>= 0), or -1 - its place among v.
   std::vector<int> free_place_;
   // The structure of B = [I; -Jv^-1 Ju] over the free coordinates: the u columns row a can be

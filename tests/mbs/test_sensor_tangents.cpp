@@ -322,6 +322,53 @@ TEST_P(Tangents, ResidualVelocityTangentMatchesCentralDifferencesAndTheFullTange
   RecordProperty("worst_error_over_allowed", std::to_string(worst.ratio));
 }
 
+// The residual's tangent in blocks, every block in one call with the directions each block may
+// take (one unit seed each: the full block every array's elements, the velocity block all but
+// q's, a group's position block the group's q, qd and qdd, its velocity block the group's qd
+// and qdd): its out is the residual, and each column equals the full tangent's for that seed.
+// The sedan must have groups (its corners, wheels and the chassis' coordinates).
+TEST_P(Tangents, ResidualTangentInBlocksIsTheFullTangentOnEachBlocksSeeds) {
+  Fixture f(GetParam());
+  ASSERT_NE(f.g, nullptr);
+  const GeneratedModel& g = *f.g;
+  if (std::string(g.name) == "sedan") ASSERT_GE(g.tangent_groups, 8);
+  if (!g.residual_tangent_groups) GTEST_SKIP() << g.name << " has no coordinate groups";
+  std::vector<Direction> dirs;
+  std::vector<int> per_block;
+  auto add_block = [&](auto keep) {
+    int count = 0;
+    for (const Direction& d : directions(g))
+      if (keep(d)) dirs.push_back(d), ++count;
+    per_block.push_back(count);
+  };
+  add_block([](const Direction&) { return true; });
+  add_block([](const Direction& d) { return d.array != kQ; });
+  for (int group = 0; group < g.tangent_groups; ++group) {
+    const auto in_group = [&](const Direction& d) { return d.array <= kQdd && g.tangent_group[d.index] == group; };
+    add_block(in_group);
+    add_block([&](const Direction& d) { return d.array != kQ && in_group(d); });
+    EXPECT_GT(per_block.back(), 0) << g.name << ": group " << group << " has no coordinate";
+  }
+  std::mt19937 rng(27);
+  for (int state = 0; state < kStates; ++state) {
+    const Args a = random_args(rng, g, f.p);
+    const int k = g.n + g.m;
+    const Tangent blocks = call_seeded(k, g, dirs, [&](int, const std::vector<std::vector<double>>& seeds, double* out,
+                                                       double* dout) {
+      g.residual_tangent_groups(a.q.data(), a.qd.data(), a.qdd.data(), a.lam.data(), a.inp.data(), a.p.data(),
+                                per_block.data(), seeds[kQ].data(), seeds[kQd].data(), seeds[kQdd].data(),
+                                seeds[kInp].data(), seeds[kP].data(), out, dout);
+    });
+    const Tangent full = call_tangent(g.residual_tangent, k, g, a, dirs);
+    EXPECT_LE((blocks.out - full.out).cwiseAbs().maxCoeff(), 1e-13 * std::max(full.out.cwiseAbs().maxCoeff(), 1.0))
+        << g.name << ": the blocks' out is not the residual";
+    for (int d = 0; d < static_cast<int>(dirs.size()); ++d)
+      EXPECT_LE((blocks.dout.col(d) - full.dout.col(d)).cwiseAbs().maxCoeff(),
+                1e-12 * std::max(full.dout.cwiseAbs().maxCoeff(), 1.0))
+          << g.name << ": direction " << d << " (" << kArrayNames[dirs[d].array] << "[" << dirs[d].index << "])";
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Models, Tangents, ::testing::Values(DYDP_TEST_MODELS),
                          [](const auto& info) { return info.param; });
 
