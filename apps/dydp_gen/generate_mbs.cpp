@@ -234,17 +234,56 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   std::vector<EmittedFunction> velocity_tangent;
   velocity_tangent.push_back(
       tangent(name + "_residual_velocity_tangent", *lists.residual, {lists.qd, lists.qdd, lists.inp, lists.p}));
-  // The residual's tangent in blocks (symbolic/grouped_tangent.hpp): a full block and a velocity
-  // block (as the two functions above), then for each group of coordinates that move together a
-  // position block (q, qd, qdd seeded in the group) and a velocity block (qd, qdd in the group),
-  // all after one primal. A group is kept when its position block costs at most half of the
-  // full one per direction; models without constraints have none (the groups of a chain are its
-  // single joints, whose blocks the full tangent serves).
   const std::size_t n = model.coordinates(), m = model.constraint_count();
   std::vector<EmittedFunction> tangent_groups_tu;  // its own file: the largest of the model's functions
+  // (jacobian_nonzero: the descriptor's, and the coupling of the tangent's coordinate groups)
   const std::vector<int> jacobian_nonzero = jacobian_structure(lists, static_cast<int>(m), static_cast<int>(n));
   std::vector<int> tangent_group(n, -1);
   int tangent_groups = 0;
+  auto part = [&](const std::string& label, const EquationList& list, std::size_t from, std::size_t to) {
+    EquationList alone(list.context());
+    for (const auto& a : list.assignments()) alone.append(a);
+    for (std::size_t k = from; k < to; ++k) alone.add_output(list.outputs()[k]);
+    const EquationList c = compact(eliminate(alone));
+    result.parts.push_back({label, list.size(), c.size(), count_ops(c)});
+  };
+  part(name + "_residual.inverse_dynamics", *lists.applied, 0, n);
+  part(name + "_residual.constraint_accelerations", *lists.applied, n, n + m);
+  part(name + "_residual_tangent.primal_with_cut_forces", *lists.residual, 0, n);
+  if (lists.constraint_kinematics) {
+    part(name + "_constraints.h_J_Jdot_qd", *lists.constraint_kinematics, 0, m + m * n + m);
+    part(name + "_constraints.Jdot_qd", *lists.constraint_kinematics, m + m * n, m + m * n + m);
+  }
+  kinematics.push_back(plain(name + "_constraints", *lists.constraints));
+  kinematics.push_back(tangent(name + "_constraints_tangent", *lists.position_constraints, all_seeded));
+  kinematics.push_back(tangent(name + "_velocity_constraints_tangent", *lists.velocity_constraints, all_seeded));
+  sensors.push_back(plain(name + "_sensors", *lists.sensors));
+  sensors.push_back(tangent(name + "_sensors_tangent", *lists.sensors, all_seeded));
+  // The sensors in two groups, for a block that asks for positions and velocities before the
+  // loads are known and for accelerations after: each call computes its own group only.
+  for (const bool acceleration : {false, true}) {
+    EquationList group(lists.sensors->context());
+    for (const auto& a : lists.sensors->assignments()) group.append(a);
+    std::size_t at = 0;
+    for (const auto& sensor : model.sensors) {
+      const std::size_t width = static_cast<std::size_t>(sensor.width());
+      if (reads_acceleration(sensor) == acceleration)
+        for (std::size_t k = 0; k < width; ++k) group.add_output(lists.sensors->outputs()[at + k]);
+      at += width;
+    }
+    const EquationList reduced = symbolic::eliminate(group);
+    const std::string fn = name + (acceleration ? "_sensors_acceleration" : "_sensors_kinematic");
+    sensors.push_back(plain(fn, reduced));
+    sensors.push_back(tangent(fn + "_tangent", reduced, all_seeded));
+  }
+  for (const auto& j : lists.jacobians) sensors.push_back(plain(j.name, *j.list));
+  // The residual's tangent in blocks (symbolic/grouped_tangent.hpp): a full block and a velocity
+  // block (as the residual's two tangents above), then for each group of coordinates that move
+  // together a position block (q, qd, qdd seeded in the group) and a velocity block (qd, qdd in
+  // the group), all after one primal. A group is kept when its position block costs at most half
+  // of the full one per direction; models without constraints have none (the groups of a chain
+  // are its single joints, whose blocks the full tangent serves). Built last, so that the other
+  // functions' auxiliaries keep the names they had without it.
   if (m > 0) {
     auto specs_for = [&](const std::vector<std::vector<int>>& groups) {
       std::vector<BlockSeeds> specs{{"full", {{lists.q, {}}, {lists.qd, {}}, {lists.qdd, {}}, {lists.inp, {}}, {lists.p, {}}}},
@@ -288,43 +327,6 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
         for (int c : kept[g]) tangent_group[c] = static_cast<int>(g);
     }
   }
-  auto part = [&](const std::string& label, const EquationList& list, std::size_t from, std::size_t to) {
-    EquationList alone(list.context());
-    for (const auto& a : list.assignments()) alone.append(a);
-    for (std::size_t k = from; k < to; ++k) alone.add_output(list.outputs()[k]);
-    const EquationList c = compact(eliminate(alone));
-    result.parts.push_back({label, list.size(), c.size(), count_ops(c)});
-  };
-  part(name + "_residual.inverse_dynamics", *lists.applied, 0, n);
-  part(name + "_residual.constraint_accelerations", *lists.applied, n, n + m);
-  part(name + "_residual_tangent.primal_with_cut_forces", *lists.residual, 0, n);
-  if (lists.constraint_kinematics) {
-    part(name + "_constraints.h_J_Jdot_qd", *lists.constraint_kinematics, 0, m + m * n + m);
-    part(name + "_constraints.Jdot_qd", *lists.constraint_kinematics, m + m * n, m + m * n + m);
-  }
-  kinematics.push_back(plain(name + "_constraints", *lists.constraints));
-  kinematics.push_back(tangent(name + "_constraints_tangent", *lists.position_constraints, all_seeded));
-  kinematics.push_back(tangent(name + "_velocity_constraints_tangent", *lists.velocity_constraints, all_seeded));
-  sensors.push_back(plain(name + "_sensors", *lists.sensors));
-  sensors.push_back(tangent(name + "_sensors_tangent", *lists.sensors, all_seeded));
-  // The sensors in two groups, for a block that asks for positions and velocities before the
-  // loads are known and for accelerations after: each call computes its own group only.
-  for (const bool acceleration : {false, true}) {
-    EquationList group(lists.sensors->context());
-    for (const auto& a : lists.sensors->assignments()) group.append(a);
-    std::size_t at = 0;
-    for (const auto& sensor : model.sensors) {
-      const std::size_t width = static_cast<std::size_t>(sensor.width());
-      if (reads_acceleration(sensor) == acceleration)
-        for (std::size_t k = 0; k < width; ++k) group.add_output(lists.sensors->outputs()[at + k]);
-      at += width;
-    }
-    const EquationList reduced = symbolic::eliminate(group);
-    const std::string fn = name + (acceleration ? "_sensors_acceleration" : "_sensors_kinematic");
-    sensors.push_back(plain(fn, reduced));
-    sensors.push_back(tangent(fn + "_tangent", reduced, all_seeded));
-  }
-  for (const auto& j : lists.jacobians) sensors.push_back(plain(j.name, *j.list));
 
   bool automatic = false;
   const std::vector<int> independent = choose_independent(model, automatic);
