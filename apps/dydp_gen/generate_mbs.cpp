@@ -74,6 +74,16 @@ EquationList derivative_outputs_only(const EquationList& tangent) {
   return list;
 }
 
+// The operations of one derivative part of a tangent list: assignments [first_assignment,
+// end_assignment) and outputs [first_output, end_output), what each of its directions costs.
+OpCount part_ops(const EquationList& list, std::size_t first_assignment, std::size_t end_assignment,
+                       std::size_t first_output, std::size_t end_output) {
+  EquationList part(list.context());
+  for (std::size_t k = first_assignment; k < end_assignment; ++k) part.append(list.assignments()[k]);
+  for (std::size_t k = first_output; k < end_output; ++k) part.add_output(list.outputs()[k]);
+  return count_ops(part);
+}
+
 // Independent coordinates: the model's, or the columns a pivoted QR of J (free columns, at the
 // initial configuration) leaves after picking the m best conditioned dependent ones.
 std::vector<int> choose_independent(const mbs::Model& model, bool& automatic) {
@@ -192,10 +202,8 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
     const EquationList t = compact(eliminate(d, &stats));
     emit.function_name = fn;
     result.functions.push_back({fn, stats.before, t.size(), count_ops(t)});
-    EquationList per_direction(t.context());
-    for (std::size_t k = t.primal_assignments(); k < t.size(); ++k) per_direction.append(t.assignments()[k]);
-    for (std::size_t k = t.primal_outputs(); k < t.outputs().size(); ++k) per_direction.add_output(t.outputs()[k]);
-    result.functions.back().ops_per_direction = count_ops(per_direction).total();
+    result.functions.back().ops_per_direction =
+        part_ops(t, t.primal_assignments(), t.size(), t.primal_outputs(), t.outputs().size()).total();
     EmittedFunction f = emit_tangent(t, arrays, emit);
     measure_text(f.definition, result.functions.back());
     return f;
@@ -299,10 +307,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
     };
     auto block_ops = [](const GroupedTangent& t, std::size_t b) {
       const TangentBlock& block = t.blocks[b];
-      EquationList alone(t.list.context());
-      for (std::size_t k = block.assignments_begin; k < block.assignments_end; ++k) alone.append(t.list.assignments()[k]);
-      for (std::size_t k = block.outputs_begin; k < block.outputs_end; ++k) alone.add_output(t.list.outputs()[k]);
-      return count_ops(alone);
+      return part_ops(t.list, block.assignments_begin, block.assignments_end, block.outputs_begin, block.outputs_end);
     };
     const std::vector<std::vector<int>> candidates = coupled_coordinates(model, jacobian_nonzero);
     const GroupedTangent trial = grouped_tangent(*lists.residual, specs_for(candidates));
@@ -314,7 +319,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
       const std::string fn = name + "_residual_tangent_groups";
       emit.function_name = fn;
       result.functions.push_back({fn, lists.residual->size(), grouped.list.size(), count_ops(grouped.list)});
-      // each block's operations per direction
+      // each block's part (what one of its directions costs)
       for (std::size_t b = 0; b < grouped.blocks.size(); ++b) {
         const std::size_t size = grouped.blocks[b].assignments_end - grouped.blocks[b].assignments_begin;
         result.parts.push_back({fn + "." + grouped.blocks[b].label, size, size, block_ops(grouped, b)});
