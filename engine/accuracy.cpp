@@ -102,7 +102,8 @@ AccuracyReport accuracy_study(Diagram& d, const AccuracySpec& spec,
   if (spec.given_setting) {
     d.solver = saved;
     const bool cvodes = saved.method == "bdf" || saved.method == "adams";
-    attempt(saved.method + " (given)", cvodes ? saved.rtol : (saved.step > 0 ? saved.step : d.time.output_step / 10));
+    const std::string order = cvodes && saved.max_order > 0 ? " order <= " + std::to_string(saved.max_order) : "";
+    attempt(saved.method + order + " (given)", cvodes ? saved.rtol : (saved.step > 0 ? saved.step : d.time.output_step / 10));
   }
   d.solver = saved;
   return report;

@@ -94,6 +94,14 @@ TEST_F(SolverOptions, SweepReplayAndAccuracyTakeThem) {
   const std::string csv = read_text(acc / "accuracy.csv");
   EXPECT_NE(csv.find("bdf (given)"), std::string::npos) << csv;
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 2) << csv;  // header and the one row
+
+  // with --max-order the given row names the order
+  const fs::path ordered = dir_ / "ordered";
+  r = dydp("accuracy " + quote(msd_path()) + " --max-order 2 --out " + quote(ordered.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string csv2 = read_text(ordered / "accuracy.csv");
+  EXPECT_NE(csv2.find("bdf order <= 2 (given)"), std::string::npos) << csv2;
+  EXPECT_NE(read_text(ordered / "accuracy.md").find("bdf order <= 2 (given)"), std::string::npos);
 }
 
 TEST_F(SolverOptions, ValuesTheSceneWouldRefuseAreRefused) {
