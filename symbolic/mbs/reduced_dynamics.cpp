@@ -469,6 +469,16 @@ void ReducedDynamics::residual_tangent(const Result& r, const double* lam, const
     int* const count = w.per_block.data();
     int* const next = count + blocks;  // where each block's next direction goes in order
     for (int d = 0; d < nd; ++d) ++count[w.block[d] = tangent_block(w, d, dq, dqd, dqdd)];
+    // A block runs its directions two at a time and an odd last one alone; the position block
+    // takes a velocity direction of its group (dq = 0 is a seed like any other there) to make
+    // up a pair: one pass on pairs costs less than the odd pass and the velocity block's.
+    for (int b = 0; b < blocks; b += 2)
+      if (count[b] % 2 == 1 && count[b + 1] > 0)
+        for (int d = nd - 1; d >= 0; --d)
+          if (w.block[d] == b + 1) {
+            w.block[d] = b, ++count[b], --count[b + 1];
+            break;
+          }
     for (int b = 1; b < blocks; ++b) next[b] = next[b - 1] + count[b - 1];
     for (int d = 0; d < nd; ++d) w.order[next[w.block[d]]++] = d;
     const DirectionSeeds s = directions(w.order, dq, dqd, dqdd, w.dout, w);
