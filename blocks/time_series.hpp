@@ -29,7 +29,6 @@ class TimeSeries {
   size_t segment(double t) const;
   std::vector<double> t_, y_;
   std::vector<double> slope_;  // the spline's slope at each sample
-
 };
 
 /// Why a recording does not cover the run [t_start, t_stop] (it starts late or ends early, and

@@ -201,12 +201,15 @@ ArrayId Context::seed_array(ArrayId of) {
   for (ArrayId a = 0; a < arrays_.size(); ++a) {
     if (arrays_[a].kind == SymbolKind::Seed && arrays_[a].seed_of == of) return a;
   }
-  std::string name = unique_name("d" + arrays_.at(of).name);
   names_.insert("seed_" + arrays_.at(of).name);  // the tangent function's argument
+  return new_seed_array(of, unique_name("d" + arrays_.at(of).name), "");
+}
+
+ArrayId Context::new_seed_array(ArrayId of, std::string name, std::string_view separator) {
   const auto id = static_cast<ArrayId>(arrays_.size());
   arrays_.push_back(Array{name, SymbolKind::Seed, {}, of});
   for (std::size_t i = 0; i < arrays_[of].elements.size(); ++i) {
-    arrays_[id].elements.push_back(new_symbol(unique_name(name + std::to_string(i + 1)),
+    arrays_[id].elements.push_back(new_symbol(unique_name(name + std::string(separator) + std::to_string(i + 1)),
                                               SymbolKind::Seed, id, static_cast<std::uint32_t>(i)));
   }
   return id;
@@ -214,14 +217,7 @@ ArrayId Context::seed_array(ArrayId of) {
 
 ArrayId Context::add_seed_array(ArrayId of, std::string_view suffix) {
   seed_array(of);  // the generic one first, so that seed_array never returns this one
-  std::string name = unique_name("d" + arrays_.at(of).name + "_" + std::string(suffix));
-  const auto id = static_cast<ArrayId>(arrays_.size());
-  arrays_.push_back(Array{name, SymbolKind::Seed, {}, of});
-  for (std::size_t i = 0; i < arrays_[of].elements.size(); ++i) {
-    arrays_[id].elements.push_back(new_symbol(unique_name(name + "_" + std::to_string(i + 1)),
-                                              SymbolKind::Seed, id, static_cast<std::uint32_t>(i)));
-  }
-  return id;
+  return new_seed_array(of, unique_name("d" + arrays_.at(of).name + "_" + std::string(suffix)), "_");
 }
 
 std::optional<ArrayId> Context::find_array(std::string_view name) const {

@@ -143,6 +143,8 @@ class Context {
   void grow_table();
   std::string unique_name(std::string_view wanted);
   NodeId new_symbol(std::string name, SymbolKind kind, ArrayId array, std::uint32_t index);
+  // A Seed array `name` for `of`, its elements named name<separator><i + 1>.
+  ArrayId new_seed_array(ArrayId of, std::string name, std::string_view separator);
 
   // simplify.cpp
   // Canonical order of sum terms and product factors: by leading leaf (symbols, then

@@ -26,8 +26,7 @@ class BlockOf {
     if (known != kUnknown) return known;
     int found = kPrimal;
     if (ctx_.op(n) != Op::Symbol) {
-      const std::vector<NodeId> children(ctx_.children(n).begin(), ctx_.children(n).end());
-      for (NodeId c : children) {
+      for (NodeId c : ctx_.children(n)) {  // no node is built here: the span stays valid
         const int b = (*this)(c);
         if (b == kPrimal) continue;
         if (found != kPrimal && found != b)
@@ -35,7 +34,7 @@ class BlockOf {
         found = b;
       }
     }
-    return known = found;  // no node is built here: block_ keeps its size
+    return known = found;  // nor does block_ grow
   }
 
  private:
@@ -56,7 +55,6 @@ GroupedTangent grouped_tangent(const EquationList& list, std::span<const BlockSe
     block.label = specs[b].label;
     for (const BlockSeeds::Seeded& s : specs[b].seeds) {
       // a Seed array of this block's own (the array's first Seed array stays the generic one)
-      ctx.seed_array(s.array);
       const ArrayId seed = ctx.add_seed_array(s.array, suffix);
       block.seeds.emplace_back(s.array, seed);
       const std::size_t size = ctx.array(s.array).elements.size();
