@@ -50,7 +50,9 @@ struct Point {
 
 /// Section of the electro-valve: geometric interpolation between the hard section at 0.3 A and
 /// the soft one at 1.6 A, A_v = A_hard (A_soft / A_hard)^xi, xi = (i - 0.3) / 1.3.
-Point evaluate(const Eval& e, bool with_inputs) {
+/// with_inputs: also what the stroke and its rate enter (the chambers' derivatives); forces:
+/// also the force and the power (not needed for the derivatives alone).
+Point evaluate(const Eval& e, bool with_inputs, bool forces = true) {
   const double* p = e.p;
   const double* x = e.x;
   Point o{};
@@ -77,9 +79,6 @@ Point evaluate(const Eval& e, bool with_inputs) {
   o.inertance = p[kDensity] * p[kPipeLength] / p[kPipeSection];
   o.pdot_res = p[kPolytropic] * x[kPRes] / o.v_gas * (o.base.q + x[kQValve]);
   o.qdot = (x[kPReb] - x[kPRes] - o.valve.dp - o.port.dp) / o.inertance;
-  const double hydraulic_power =
-      o.piston.q * (x[kPReb] - x[kPComp]) + o.base.q * (x[kPComp] - x[kPRes]) +
-      x[kQValve] * (o.valve.dp + o.port.dp);
   if (!with_inputs) return o;
   const double stroke = e.u[0][0];
   o.rate = e.u[1][0];
@@ -89,6 +88,10 @@ Point evaluate(const Eval& e, bool with_inputs) {
   const double b = p[kBulkModulus];
   o.pdot_reb = b / o.v_reb * (o.area_annulus * o.rate - o.piston.q - x[kQValve]);
   o.pdot_comp = b / o.v_comp * (o.piston.q - o.base.q - o.area_piston * o.rate);
+  if (!forces) return o;
+  const double hydraulic_power =
+      o.piston.q * (x[kPReb] - x[kPComp]) + o.base.q * (x[kPComp] - x[kPRes]) +
+      x[kQValve] * (o.valve.dp + o.port.dp);
   o.th = std::tanh(o.rate / p[kFrictionVelocity]);
   const double friction = p[kFriction] * o.th;
   o.force = x[kPReb] * o.area_annulus - x[kPComp] * o.area_piston + p[kAtmosphere] * o.area_rod + friction;
@@ -237,7 +240,7 @@ class DamperCdc : public Block {
     }
   }
   void derivatives(const Eval& e, double* xdot) const override {
-    const Point o = evaluate(e, true);
+    const Point o = evaluate(e, true, false);
     xdot[kPReb] = o.pdot_reb;
     xdot[kPComp] = o.pdot_comp;
     xdot[kPRes] = o.pdot_res;
@@ -261,7 +264,15 @@ class DamperCdc : public Block {
     for (int i = 0; i < 4; ++i) identity[i * 4 + i] = 1.0;
     const engine::ConstDirView held[2] = {};  // stroke and stroke rate held
     const Seeds s{4, {identity, 4}, held, {}};
-    derivatives_tangent(e, s, jac);
+    const Point o = evaluate(e, true, false);  // the derivatives' tangents read no force
+    const TangentLogs logs = tangent_logs(e);
+    for (int d = 0; d < 4; ++d) {
+      const PointTangent t = tangent(e, o, logs, s, d, true);
+      jac(kPReb, d) = t.pdot_reb;
+      jac(kPComp, d) = t.pdot_comp;
+      jac(kPRes, d) = t.pdot_res;
+      jac(kQValve, d) = t.qdot;
+    }
     return true;
   }
 };

@@ -204,15 +204,45 @@ void Evaluator::tangents(double t, const double* x, int nd, ConstDirView dx, boo
 
 bool Evaluator::local_jacobians(double t, const double* x, double* jac, int ld) {
   outputs(t, x);
-  bool any = false;
+  local_ranges_.clear();
+  local_nodes_.clear();
   for (size_t i = 0; i < d_.nodes.size(); ++i) {
     const Node& n = d_.nodes[i];
     if (n.block->num_states() == 0) continue;
     const Eval e = eval_for(n, static_cast<int>(i), t, x);
     double* block = jac + static_cast<size_t>(n.state_offset) * ld + n.state_offset;
-    call_block(n, [&] { any = n.block->local_jacobian(e, {block, ld}) || any; });
+    bool provided = false;
+    call_block(n, [&] { provided = n.block->local_jacobian(e, {block, ld}); });
+    if (!provided) continue;
+    local_ranges_.push_back({n.state_offset, n.block->num_states()});
+    local_nodes_.push_back(static_cast<int>(i));
   }
-  return any;
+  return !local_nodes_.empty();
+}
+
+void Evaluator::local_derivatives(double t, const double* x, double* xdot) {
+  for (int i : local_nodes_) {
+    const Node& n = d_.nodes[i];
+    call_block(n, [&] { n.block->derivatives(eval_for(n, i, t, x), xdot + n.state_offset); });
+  }
+}
+
+void Evaluator::local_jacobians_held(double t, const double* x, double* jac, int ld) {
+  for (int i : local_nodes_) {
+    const Node& n = d_.nodes[i];
+    double* block = jac + static_cast<size_t>(n.state_offset) * ld + n.state_offset;
+    call_block(n, [&] { n.block->local_jacobian(eval_for(n, i, t, x), {block, ld}); });
+  }
+}
+
+void Evaluator::local_derivatives_tangent(double t, const double* x, int nd, ConstDirView dx, bool with_params,
+                                          DirView dxdot) {
+  for (int i : local_nodes_) {
+    const Node& n = d_.nodes[i];
+    const Eval e = eval_for(n, i, t, x);
+    const Seeds s = seeds_for(n, i, nd, dx, with_params);
+    call_block(n, [&] { n.block->derivatives_tangent(e, s, {dxdot.data + n.state_offset, dxdot.ld}); });
+  }
 }
 
 bool Evaluator::all_finite(const double* xdot) const {

@@ -44,6 +44,19 @@ class Evaluator {
   /// for every block that provides Block::local_jacobian, at (t, x). False when none does.
   bool local_jacobians(double t, const double* x, double* jac, int ld);
 
+  /// The states of the blocks that gave a local Jacobian in the last local_jacobians call:
+  /// (first state, count) per block, in state order.
+  const std::vector<std::pair<int, int>>& local_state_ranges() const { return local_ranges_; }
+  /// For those blocks alone, at the states x (a whole state vector; other blocks' states are not
+  /// read) with their inputs as the last value pass left them: their rows of xdot, their
+  /// diagonal blocks of d(xdot)/dx (like local_jacobians), and their rows of the tangent for
+  /// state seeds dx, the input seeds of the last tangent pass and, when with_params, the
+  /// parameter seeds. Nothing else is evaluated, so a solver can iterate on these blocks' states
+  /// at a fixed point of the rest (Rosenbrock-W's local stages, docs/engine.md).
+  void local_derivatives(double t, const double* x, double* xdot);
+  void local_jacobians_held(double t, const double* x, double* jac, int ld);
+  void local_derivatives_tangent(double t, const double* x, int nd, ConstDirView dx, bool with_params, DirView dxdot);
+
   const std::vector<double>& signals() const { return sig_; }
   /// Signal tangents of the last tangent pass: element (i, d) at [d * num_signals + i].
   const std::vector<double>& signal_tangents() const { return dsig_; }
@@ -78,6 +91,8 @@ class Evaluator {
   std::vector<DirView> dy_;            ///< scratch for a node's output seed views
   std::vector<double> zero_x_;         ///< seeds for state-less evaluations
   bool valid_ = false;
+  std::vector<std::pair<int, int>> local_ranges_;  ///< see local_state_ranges
+  std::vector<int> local_nodes_;                   ///< their nodes
   double last_t_ = 0.0;
   std::vector<double> last_x_;
 };
