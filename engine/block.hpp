@@ -149,7 +149,10 @@ class Block {
   /// Optional: d(xdot)/dx over the block's own states with its inputs held, column j at
   /// jac.data + j * jac.ld. Blocks whose derivatives are cheap but strongly nonlinear in their
   /// own states (hydraulic chambers) provide it, so that an implicit solver can refresh this
-  /// diagonal block of its iteration matrix without a whole Jacobian. False: not provided.
+  /// diagonal block of its iteration matrix without a whole Jacobian, and Rosenbrock-W solves
+  /// the block's rows of each stage exactly (Newton on its own states, its inputs held at the
+  /// stage's base point: the block's inputs must not depend on its own states within one
+  /// evaluation). False: not provided.
   virtual bool local_jacobian(const Eval& e, DirView jac) const { return false; }
 
   /// Integrands of the block's quadratures (objective integrals), and their tangents.
