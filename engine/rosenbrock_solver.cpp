@@ -8,6 +8,7 @@
 #include "engine/cpu_clock.hpp"
 #include "engine/errors.hpp"
 #include "engine/jacobian_colouring.hpp"
+#include "engine/local_stages.hpp"
 #include "engine/newton_lu.hpp"
 #include "engine/recorder.hpp"
 #include "engine/timeline.hpp"
@@ -51,21 +52,6 @@ const double kDivergenceFloor = 1e-3;
 /// A step whose stage fails (non-finite value, state refused by a block) with a fresh W is taken
 /// as two of half the size, down to 1/2^this of the scene's step; then the run stops.
 const int kMaxHalvings = 6;
-/// The local stages' Newton iteration: converged when its last correction moves no local state
-/// by more than this fraction of its nominal magnitude (or of its value, where larger); a stage
-/// that has not converged in kLocalIterations is taken in halves like a failed one.
-const double kLocalTolerance = 1e-6;
-/// The iteration keeps the matrix of the last stage (its local blocks at that stage's solution)
-/// while each correction is at most this fraction of the one before; a slower one, as where a
-/// valve opens within the step, has the local blocks evaluated at the current iterate.
-const double kRefactorRate = 0.1;
-const int kLocalIterations = 10;
-
-/// A stage's value was not finite, or a block refused its state: the step is retried.
-struct StageFailure {
-  double t;
-  std::string block, why;
-};
 
 /// The scheme's state (x, q and their sensitivities S, Sq), W and its factorisation, and the
 /// start-of-step evaluations f(tn, xn), g(tn, xn) and their tangents, which the last step's
@@ -74,7 +60,8 @@ class Ros2Stepper {
  public:
   Ros2Stepper(const Diagram& d, Evaluator& ev, int ns, RunStats& stats, const std::vector<double>* fixed_w)
       : ev_(ev), nx_(d.num_states), nq_(d.num_quadratures), ns_(ns), stats_(stats), fixed_(fixed_w != nullptr),
-        w_(nx_, nx_), identity_(Matrix::Identity(nx_, nx_)), colouring_(d) {
+        w_(nx_, nx_), identity_(Matrix::Identity(nx_, nx_)), colouring_(d),
+        local_(ev, stats, kGamma, state_nominals(d), ns) {
     stats_.jacobian_colours = colouring_.colours();
     const std::vector<double> nominal = state_nominals(d);
     scale_ = Eigen::Map<const Vector>(nominal.data(), nx_);
@@ -149,10 +136,10 @@ class Ros2Stepper {
       if (ns_ > 0 && !evaluator_at_start_) ev_.tangents(t, x.data(), ns_, {S.data(), nx_}, true, {}, {});
       evaluator_at_start_ = true;
       zero_.setZero(nx_);
-      local_stage(t, x, f_start_.head(nx_), zero_, h, k1_);
+      local_.solve(t, x, f_start_.head(nx_), zero_, h, k1_);
       if (ns_ > 0) {
         dzero_.setZero(nx_, ns_);
-        local_stage_tangent(t, x, S, df_start_, dzero_, h, k1_, dk1_);
+        local_.solve_tangent(t, x, S, df_start_, dzero_, h, k1_, dk1_);
       }
     } else {
       solve(f_start_.head(nx_), k1_.head(nx_));
@@ -166,10 +153,10 @@ class Ros2Stepper {
     evaluate(t_end, y_stage_.head(nx_), dy_stage_, f_stage_, g_stage_, df_stage_, dg_stage_);
     if (local_stages_) {
       cv_.noalias() = -2 * k1_;
-      local_stage(t_end, y_stage_, f_stage_, cv_, h, k2_);
+      local_.solve(t_end, y_stage_, f_stage_, cv_, h, k2_);
       if (ns_ > 0) {
         dcv_.noalias() = -2 * dk1_;
-        local_stage_tangent(t_end, y_stage_, dy_stage_, df_stage_, dcv_, h, k2_, dk2_);
+        local_.solve_tangent(t_end, y_stage_, dy_stage_, df_stage_, dcv_, h, k2_, dk2_);
       }
     } else {
       f_stage_.head(nx_) -= 2 * k1_.head(nx_);
@@ -218,174 +205,18 @@ class Ros2Stepper {
     else if (!local_stages_) refresh_local(t, x);
   }
 
-  /// Finds the states of the blocks that provide Block::local_jacobian (v; the others u). With
-  /// any, the stages are solved with those blocks' rows exact (local_stage).
+  /// Whether some block gives a local Jacobian: then its rows of each stage are solved exactly
+  /// (LocalStages), and W's local blocks are not refreshed at every step.
   void find_local_states() {
     local_checked_ = true;
-    if (nx_ == 0) return;
-    jloc_.setZero(nx_, nx_);
     try {
-      if (!ev_.local_jacobians(t, x.data(), jloc_.data(), nx_)) return;
+      local_stages_ = local_.find(t, x);
     } catch (const OutOfDomain& e) {
       throw domain_failure(t, e);
     }
-    std::vector<char> local(nx_, 0);
-    for (const auto& [first, count] : ev_.local_state_ranges())
-      for (int i = first; i < first + count; ++i) local[i] = 1;
-    for (int i = 0; i < nx_; ++i) (local[i] ? v_ : u_).push_back(i);
-    local_stages_ = true;
-    has_local_ = false;  // the per-step refresh of W's local blocks is not used
+    if (!local_stages_) return;
+    has_local_ = false;
     factored_h_ = -1.0;
-    const int nu = static_cast<int>(u_.size()), nv = static_cast<int>(v_.size());
-    ru_.setZero(nu), yu_.setZero(nu), xu_.setZero(nu), rv_.setZero(nv), xv_.setZero(nv);
-    xi_.setZero(nx_), fv_.setZero(nx_);
-  }
-
-  /// M = I - gamma h W partitioned as [A B; C D] over (u, v): A = I - gamma h W_uu factored,
-  /// B = -gamma h W_uv, C = -gamma h W_vu, and A^-1 B and C A^-1 B kept for the Schur
-  /// complement D - C A^-1 B that each local iteration factors (nv x nv).
-  void factor_partitioned(double h) {
-    const int nu = static_cast<int>(u_.size()), nv = static_cast<int>(v_.size());
-    const double gh = kGamma * h;
-    a_.resize(nu, nu), b_.resize(nu, nv), c_.resize(nv, nu);
-    for (int j = 0; j < nu; ++j)
-      for (int i = 0; i < nu; ++i) a_(i, j) = (i == j ? 1.0 : 0.0) - gh * w_(u_[i], u_[j]);
-    for (int j = 0; j < nv; ++j)
-      for (int i = 0; i < nu; ++i) b_(i, j) = -gh * w_(u_[i], v_[j]);
-    for (int j = 0; j < nu; ++j)
-      for (int i = 0; i < nv; ++i) c_(i, j) = -gh * w_(v_[i], u_[j]);
-    if (nu > 0) lu_a_.factor(a_.data(), nu);  // a zero pivot shows as a non-finite stage
-    ainv_b_ = b_;
-    for (int j = 0; j < nv && nu > 0; ++j) lu_a_.solve(ainv_b_.col(j).data(), ainv_b_.col(j).data());
-    p_ = c_ * ainv_b_;
-    schur_valid_ = false;
-  }
-
-  /// Solves M [x_u; x_v] = [r_u; r_v] with the Schur complement factored in schur_.
-  void solve_partitioned(const Vector& r_u, const Vector& r_v) {
-    yu_ = r_u;
-    if (yu_.size() > 0) lu_a_.solve(yu_.data(), yu_.data());
-    xv_ = schur_.solve(r_v - c_ * yu_);
-    xu_ = yu_ - ainv_b_ * xv_;
-  }
-
-  /// Factors S = I - gamma h J_vv(xs) - C A^-1 B, J_vv the local blocks at the states xs.
-  void factor_schur(double tb, const Vector& xs, double h) {
-    const int nv = static_cast<int>(v_.size());
-    ev_.local_jacobians_held(tb, xs.data(), jloc_.data(), nx_);
-    ++stats_.local_jac_evals;
-    schur_matrix_.resize(nv, nv);
-    for (int j = 0; j < nv; ++j)
-      for (int i = 0; i < nv; ++i)
-        schur_matrix_(i, j) = (i == j ? 1.0 : 0.0) - kGamma * h * jloc_(v_[i], v_[j]) - p_(i, j);
-    schur_.compute(schur_matrix_);
-    schur_valid_ = true;
-  }
-
-  /// A stage of ROS2 with the local blocks' rows exact: k solves
-  ///   k_u = fb_u + c_u + gamma h (W_uu k_u + W_uv k_v)                (linear, W as kept)
-  ///   k_v = f_v(t, u_b, v_b + gamma h k_v) + c_v + gamma h W_vu k_u    (the blocks' own law)
-  /// where f_v is evaluated with the blocks' inputs held at the base point xb (the last value
-  /// pass) and fb = f(tb, xb). That is ROS2 with W_vv the secant of f_v over the stage's own
-  /// increment instead of its tangent: ROS2 is of order 2 for any W, and the secant cannot
-  /// overshoot where a law's slope jumps within the step (a check valve opening). Newton's
-  /// iteration from k = 0; its first iterate is the linearly implicit stage itself.
-  void local_stage(double tb, const Vector& xb, const Eigen::Ref<const Vector>& fb, const Vector& cv, double h,
-                   Vector& k) {
-    const int nu = static_cast<int>(u_.size()), nv = static_cast<int>(v_.size());
-    const double gh = kGamma * h;
-    k.head(nx_).setZero();
-    Vector& ku = ku_;
-    Vector& kv = kv_;
-    ku.setZero(nu);
-    kv.setZero(nv);
-    xi_ = xb;
-    double last_size = 0.0, last_rate = 0.0;
-    for (int it = 0; it < kLocalIterations; ++it) {
-      try {
-        if (it == 0) {
-          for (int i = 0; i < nv; ++i) fv_(v_[i]) = fb(v_[i]);
-          // The first iterate is the linearly implicit stage itself, with the matrix of the last
-          // stage (the states have moved by a stage at most).
-          if (!schur_valid_) factor_schur(tb, xi_, h);
-        } else {
-          for (int i = 0; i < nv; ++i) xi_(v_[i]) = xb(v_[i]) + gh * kv(i);
-          ev_.local_derivatives(tb, xi_.data(), fv_.data());
-          if (it >= 2 && last_rate > kRefactorRate) factor_schur(tb, xi_, h);
-        }
-      } catch (const OutOfDomain& e) {
-        throw local_failure(tb, e);
-      }
-      for (int i = 0; i < nv; ++i) rv_(i) = kv(i) - fv_(v_[i]) - cv(v_[i]);
-      rv_.noalias() += c_ * ku;
-      if (it == 0) {
-        for (int i = 0; i < nu; ++i) ru_(i) = -(fb(u_[i]) + cv(u_[i]));
-        solve_partitioned(ru_, rv_);
-      } else {
-        // The u rows are linear and every iterate solves them exactly: their residual is zero.
-        xv_ = schur_.solve(rv_);
-        xu_.noalias() = -ainv_b_ * xv_;
-      }
-      ku -= xu_;
-      kv -= xv_;
-      ++stats_.nonlinear_iterations;
-      double size = 0.0;
-      for (int i = 0; i < nv; ++i)
-        size = std::max(size, std::abs(gh * xv_(i)) / std::max(scale_(v_[i]), std::abs(xb(v_[i]))));
-      if (!std::isfinite(size)) break;
-      // Converged when the correction, or the one its contraction rate predicts next, is below
-      // the tolerance (the usual test of implicit integrators, Hairer and Wanner IV.8).
-      const double rate = it > 0 && last_size > 0 ? size / last_size : 1.0;
-      if (it > 1 && rate >= 1.0) break;  // diverging
-      if (it > 0 && (size <= kLocalTolerance || (rate < 1.0 && rate / (1.0 - rate) * size <= kLocalTolerance))) {
-        for (int i = 0; i < nu; ++i) k(u_[i]) = ku(i);
-        for (int i = 0; i < nv; ++i) k(v_[i]) = kv(i);
-        if (ns_ > 0) {  // the sensitivities' matrix at the stage's solution
-          for (int i = 0; i < nv; ++i) xi_(v_[i]) = xb(v_[i]) + gh * kv(i);
-          try {
-            factor_schur(tb, xi_, h);
-          } catch (const OutOfDomain& e) {
-            throw local_failure(tb, e);
-          }
-        }
-        return;
-      }
-      last_size = size;
-      last_rate = rate;
-    }
-    ++stats_.nonlinear_failures;
-    throw StageFailure{tb, "", "the local stage's Newton iteration did not converge in " +
-                                   std::to_string(kLocalIterations) + " iterations"};
-  }
-
-  /// The derivative of local_stage's solution: with M* = [A B; C I - gamma h J_vv(stage)],
-  ///   M* dk = [dfb_u + dc_u; df_v(stage; dxb, the inputs' seeds, dp) + dc_v],
-  /// where df_v is the local blocks' tangent at the stage's states for the base point's state
-  /// seeds dxb and input seeds (the last tangent pass, which was at the base point).
-  void local_stage_tangent(double tb, const Vector& xb, const Matrix& dxb, const Matrix& dfb, const Matrix& dcv,
-                           double h, const Vector& k, Matrix& dk) {
-    const int nu = static_cast<int>(u_.size()), nv = static_cast<int>(v_.size());
-    xi_ = xb;
-    for (int i = 0; i < nv; ++i) xi_(v_[i]) += kGamma * h * k(v_[i]);
-    dloc_.setZero(nx_, ns_);
-    try {
-      ev_.local_derivatives_tangent(tb, xi_.data(), ns_, {dxb.data(), nx_}, true, {dloc_.data(), nx_});
-    } catch (const OutOfDomain& e) {
-      throw local_failure(tb, e);
-    }
-    for (int c = 0; c < ns_; ++c) {
-      for (int i = 0; i < nu; ++i) ru_(i) = dfb(u_[i], c) + dcv(u_[i], c);
-      for (int i = 0; i < nv; ++i) rv_(i) = dloc_(v_[i], c) + dcv(v_[i], c);
-      solve_partitioned(ru_, rv_);
-      for (int i = 0; i < nu; ++i) dk(u_[i], c) = xu_(i);
-      for (int i = 0; i < nv; ++i) dk(v_[i], c) = xv_(i);
-    }
-  }
-
-  static StageFailure local_failure(double tb, const OutOfDomain& e) {
-    const auto colon = e.reason.find(": ");
-    if (colon == std::string::npos) return StageFailure{tb, "", "input out of a block's domain: " + e.reason};
-    return StageFailure{tb, e.reason.substr(0, colon), "input out of the block's domain: " + e.reason.substr(colon + 2)};
   }
 
   /// The blocks' own diagonal blocks of W at (t, y), where blocks provide them (else nothing).
@@ -429,7 +260,7 @@ class Ros2Stepper {
 
   void factor(double h) {
     if (local_stages_) {
-      factor_partitioned(h);
+      local_.factor(w_, h);
       factored_h_ = h;
       return;
     }
@@ -487,15 +318,11 @@ class Ros2Stepper {
   double last_estimate_ = 0.0;     ///< the last accepted step's error estimate
   bool evaluator_at_start_ = false;  ///< the evaluator's last passes were at (t, x) with seeds S
   bool has_local_ = true;            ///< some block provides a local Jacobian (until found otherwise)
-  bool local_checked_ = false;
-  bool schur_valid_ = false;       ///< find_local_states has run
-  bool local_stages_ = false;        ///< stages with the local blocks' rows exact (local_stage)
-  std::vector<int> u_, v_;           ///< the other states; the local blocks' states
-  NewtonLU lu_a_;                    ///< A = I - gamma h W_uu
-  Matrix a_, b_, c_, ainv_b_, p_, jloc_, schur_matrix_, dloc_, dzero_;
-  Eigen::PartialPivLU<Matrix> schur_;
-  Vector ru_, rv_, yu_, xu_, xv_, xi_, fv_, zero_, ku_, kv_, cv_;
-  Matrix dcv_;
+  bool local_checked_ = false;       ///< find_local_states has run
+  bool local_stages_ = false;        ///< some block gives a local Jacobian: LocalStages solves
+  LocalStages local_;
+  Vector zero_, cv_;                 ///< the stages' c: 0 and -2 k1
+  Matrix dzero_, dcv_;               ///< and their tangents
   Vector scale_;
   Vector f_start_, f_end_, f_stage_, k1_, k2_, y_stage_, x_end_, g_start_, g_end_, g_stage_, q_end_;
   Matrix df_start_, df_end_, df_stage_, dk1_, dk2_, dy_stage_, s_end_, dg_start_, dg_end_, dg_stage_, sq_end_;
