@@ -41,7 +41,9 @@ TEST(RosenbrockLocalStages, ObjectivesConvergeAtOrderTwoOnTheCdcQuarterCar) {
     EXPECT_EQ(r.stats.method, "rosw");
     EXPECT_GT(r.stats.nonlinear_iterations, 2 * r.stats.steps) << "the damper's rows were not iterated";
     EXPECT_GT(r.stats.local_jac_evals, 0);
-    if (s == 2) EXPECT_EQ(r.stats.substeps, 0);
+    if (s == 2) {
+      EXPECT_EQ(r.stats.substeps, 0);
+    }
     ASSERT_EQ(r.objectives.size(), 3u);
     for (int k = 0; k < 3; ++k) err[s][k] = relative(r.objectives[k].value, ref.objectives[k].value);
   }
