@@ -34,11 +34,8 @@ using Vector = Eigen::VectorXd;
 // A-stable as well (gamma >= 1/4) and whose error constant on y' = lambda y is 34 times smaller
 // (1/6 - 3 gamma^2 + 2 gamma^3: -0.040 against 1.37), the same gamma as SDIRK2's.
 const double kGamma = 1.0 - 1.0 / std::sqrt(2.0);
-/// W is evaluated afresh after this many steps; in between, the diagonal blocks that blocks
-/// provide cheaply (Block::local_jacobian: the damper's pressures) are refreshed at every step.
-/// Without that, ROS2 is unstable on the damper's orifice laws at any step tried on the sedan
-/// (a linearised step overshoots where the flow goes as the square root of the pressure drop and
-/// the slope there moves within the step); docs/performance.md, 2026-12-02.
+/// W is evaluated afresh after this many steps (and at the start, after each breakpoint, and
+/// when a step's error estimate jumps).
 const int kRefreshSteps = 50;
 /// With local stages W carries the rest of the diagram (the car, its couplings to the local
 /// blocks) and none of the stiff laws: kept 4 times longer. On the sedan's shaker file it costs
@@ -202,7 +199,6 @@ class Ros2Stepper {
     ++stats_.steps;
     if (fixed_) return;
     if (++age_ >= (local_stages_ ? kRefreshStepsLocal : kRefreshSteps)) refresh(t, x);
-    else if (!local_stages_) refresh_local(t, x);
   }
 
   /// Whether some block gives a local Jacobian: then its rows of each stage are solved exactly
@@ -214,23 +210,7 @@ class Ros2Stepper {
     } catch (const OutOfDomain& e) {
       throw domain_failure(t, e);
     }
-    if (!local_stages_) return;
-    has_local_ = false;
-    factored_h_ = -1.0;
-  }
-
-  /// The blocks' own diagonal blocks of W at (t, y), where blocks provide them (else nothing).
-  void refresh_local(double t_at, const Vector& y) {
-    if (!has_local_ || nx_ == 0) return;
-    try {
-      has_local_ = ev_.local_jacobians(t_at, y.data(), w_.data(), nx_);
-    } catch (const OutOfDomain& e) {
-      throw domain_failure(t_at, e);
-    }
-    if (!has_local_) return;
-    ++stats_.local_jac_evals;
-    factored_h_ = -1.0;
-    evaluator_at_start_ = false;
+    if (local_stages_) factored_h_ = -1.0;
   }
 
   /// refresh(t, y), false when a block refuses the point.
@@ -317,7 +297,6 @@ class Ros2Stepper {
   int age_ = 0;                    ///< steps taken since W was evaluated
   double last_estimate_ = 0.0;     ///< the last accepted step's error estimate
   bool evaluator_at_start_ = false;  ///< the evaluator's last passes were at (t, x) with seeds S
-  bool has_local_ = true;            ///< some block provides a local Jacobian (until found otherwise)
   bool local_checked_ = false;       ///< find_local_states has run
   bool local_stages_ = false;        ///< some block gives a local Jacobian: LocalStages solves
   LocalStages local_;
