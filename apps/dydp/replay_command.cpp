@@ -83,16 +83,17 @@ int replay_command(const ReplayArgs& args) {
   engine::Diagram d = engine::load_scene(args.scene, parse_sets(args.sets), {{"input_file", input}});
   // Replay integrates with Rosenbrock-W (rosw) unless --solver names another integrator: its
   // local stages follow the dampers' valves at millisecond steps (docs/engine.md).
+  // With rosw, named or not, the step is --step, else the scene's own rosw step, else 2.5 ms.
   engine::SolverOverrides solver = args.solver;
   if (solver.method.empty()) {
     if (solver.max_order)
       throw engine::InputError("--max-order", 0, "",
                                "applies to bdf and adams; replay integrates with rosw unless --solver names another "
                                "(add --solver bdf)");
-    const bool scene_rosw_step = d.solver.method == "rosw" && d.solver.step > 0;
     solver.method = "rosw";
-    if (!solver.step && !scene_rosw_step) solver.step = kReplayStep;
   }
+  const bool scene_rosw_step = d.solver.method == "rosw" && d.solver.step > 0;
+  if (solver.method == "rosw" && !solver.step && !scene_rosw_step) solver.step = kReplayStep;
   engine::apply_solver_overrides(d, solver);
   bool takes_input = false;
   for (const auto& n : d.nodes)
