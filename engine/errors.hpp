@@ -62,12 +62,13 @@ class SolverError : public std::runtime_error {
 };
 
 /// A fixed-step method cannot retry: an input out of a block's domain ends the run. The
-/// reason comes as "block: why" from the evaluator.
-template <class DomainError>
-SolverError domain_failure(double t, const DomainError& e) {
+/// reason comes as "block: why" from the evaluator. Failure: what is made of (t, block, why),
+/// the run's SolverError or a retried step's own failure (Rosenbrock-W's StageFailure).
+template <class Failure = SolverError, class DomainError>
+Failure domain_failure(double t, const DomainError& e) {
   const auto colon = e.reason.find(": ");
-  if (colon == std::string::npos) return SolverError(t, "", "input out of a block's domain: " + e.reason);
-  return SolverError(t, e.reason.substr(0, colon), "input out of the block's domain: " + e.reason.substr(colon + 2));
+  if (colon == std::string::npos) return Failure{t, "", "input out of a block's domain: " + e.reason};
+  return Failure{t, e.reason.substr(0, colon), "input out of the block's domain: " + e.reason.substr(colon + 2)};
 }
 
 }  // namespace dydp::engine

@@ -74,12 +74,6 @@ void LocalStages::factor_schur(double tb, const Vector& xs, double h) {
   schur_valid_ = true;
 }
 
-StageFailure LocalStages::failure(double tb, const OutOfDomain& e) {
-  const auto colon = e.reason.find(": ");
-  if (colon == std::string::npos) return StageFailure{tb, "", "input out of a block's domain: " + e.reason};
-  return StageFailure{tb, e.reason.substr(0, colon), "input out of the block's domain: " + e.reason.substr(colon + 2)};
-}
-
 void LocalStages::solve(double tb, const Vector& xb, const Eigen::Ref<const Vector>& fb, const Vector& c, double h,
                         Vector& k) {
   const int nu = static_cast<int>(u_.size()), nv = static_cast<int>(v_.size());
@@ -102,7 +96,7 @@ void LocalStages::solve(double tb, const Vector& xb, const Eigen::Ref<const Vect
         if (it >= 2 && last_rate > kRefactorRate) factor_schur(tb, xi_, h);
       }
     } catch (const OutOfDomain& e) {
-      throw failure(tb, e);
+      throw domain_failure<StageFailure>(tb, e);
     }
     for (int i = 0; i < nv; ++i) rv_(i) = kv_(i) - fv_(v_[i]) - c(v_[i]);
     rv_.noalias() += c_ * ku_;
@@ -133,7 +127,7 @@ void LocalStages::solve(double tb, const Vector& xb, const Eigen::Ref<const Vect
         try {
           factor_schur(tb, xi_, h);
         } catch (const OutOfDomain& e) {
-          throw failure(tb, e);
+          throw domain_failure<StageFailure>(tb, e);
         }
       }
       return;
@@ -155,7 +149,7 @@ void LocalStages::solve_tangent(double tb, const Vector& xb, const Matrix& dxb, 
   try {
     ev_.local_derivatives_tangent(tb, xi_.data(), ns_, {dxb.data(), nx_}, true, {dloc_.data(), nx_});
   } catch (const OutOfDomain& e) {
-    throw failure(tb, e);
+    throw domain_failure<StageFailure>(tb, e);
   }
   for (int col = 0; col < ns_; ++col) {
     for (int i = 0; i < nu; ++i) ru_(i) = dfb(u_[i], col) + dc(u_[i], col);

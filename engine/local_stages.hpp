@@ -55,7 +55,6 @@ class LocalStages {
  private:
   void solve_partitioned(const Vector& r_u, const Vector& r_v);
   void factor_schur(double tb, const Vector& xs, double h);
-  static StageFailure failure(double tb, const OutOfDomain& e);
 
   Evaluator& ev_;
   RunStats& stats_;

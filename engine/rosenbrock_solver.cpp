@@ -132,10 +132,8 @@ class Ros2Stepper {
       ev_.outputs(t, x.data());
       if (ns_ > 0 && !evaluator_at_start_) ev_.tangents(t, x.data(), ns_, {S.data(), nx_}, true, {}, {});
       evaluator_at_start_ = true;
-      zero_.setZero(nx_);
       local_.solve(t, x, f_start_.head(nx_), zero_, h, k1_);
       if (ns_ > 0) {
-        dzero_.setZero(nx_, ns_);
         local_.solve_tangent(t, x, S, df_start_, dzero_, h, k1_, dk1_);
       }
     } else {
@@ -210,7 +208,10 @@ class Ros2Stepper {
     } catch (const OutOfDomain& e) {
       throw domain_failure(t, e);
     }
-    if (local_stages_) factored_h_ = -1.0;
+    if (!local_stages_) return;
+    factored_h_ = -1.0;
+    zero_.setZero(nx_);
+    dzero_.setZero(nx_, ns_);
   }
 
   /// refresh(t, y), false when a block refuses the point.
@@ -277,10 +278,7 @@ class Ros2Stepper {
         ++stats_.sens_rhs_evals;
       }
     } catch (const OutOfDomain& e) {
-      const auto colon = e.reason.find(": ");
-      if (colon == std::string::npos) throw StageFailure{t_at, "", "input out of a block's domain: " + e.reason};
-      throw StageFailure{t_at, e.reason.substr(0, colon),
-                         "input out of the block's domain: " + e.reason.substr(colon + 2)};
+      throw domain_failure<StageFailure>(t_at, e);
     }
   }
 

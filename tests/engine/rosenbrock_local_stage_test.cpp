@@ -17,17 +17,12 @@
 #include "engine/diagram.hpp"
 #include "engine/errors.hpp"
 #include "engine/run.hpp"
+#include "tests/engine/quarter_car_scene.hpp"
 
 namespace dydp::engine {
 namespace {
 
-Diagram quarter_car(const std::string& method, double step) {
-  Diagram d = load_scene(std::string(DYDP_SOURCE_DIR) + "/scenarios/quarter_car_cdc.yaml");
-  d.solver.method = method;
-  d.solver.step = step;
-  if (method == "bdf") d.solver.rtol = 1e-9, d.solver.atol = 1e-10;
-  return d;
-}
+Diagram quarter_car(const std::string& method, double step) { return test::quarter_car_cdc(method, step, 1e-9, 1e-10); }
 
 double relative(double a, double b) { return std::fabs(a - b) / std::fabs(b); }
 

@@ -10,17 +10,13 @@
 
 #include "engine/diagram.hpp"
 #include "engine/run.hpp"
+#include "tests/engine/quarter_car_scene.hpp"
 
 namespace dydp::engine {
 namespace {
 
-Diagram quarter_car(const std::string& method, double step) {
-  Diagram d = load_scene(std::string(DYDP_SOURCE_DIR) + "/scenarios/quarter_car_cdc.yaml");
-  d.solver.method = method;
-  d.solver.step = step;
-  if (method == "bdf") d.solver.rtol = 1e-7, d.solver.atol = 1e-9;  // agrees with 1e-8 to 7 digits
-  return d;
-}
+// BDF at rtol 1e-7 agrees with 1e-8 to 7 digits.
+Diagram quarter_car(const std::string& method, double step) { return test::quarter_car_cdc(method, step, 1e-7, 1e-9); }
 
 TEST(Substeps, FailedStagesAreTakenInHalvesAndTheRunCompletes) {
   const RunResult bdf = run(quarter_car("bdf", 0.0));
