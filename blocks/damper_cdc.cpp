@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "blocks/hydraulics.hpp"
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
 
 namespace dydp::blocks {
 namespace {

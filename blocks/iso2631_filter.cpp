@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
 
 namespace dydp::blocks {
 namespace {

@@ -3,7 +3,7 @@
 // between bodies of a multibody model).
 #include <cmath>
 
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
 
 namespace dydp::blocks {
 namespace {

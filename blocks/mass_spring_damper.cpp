@@ -1,6 +1,6 @@
 // mass_spring_damper: m a = f - c v - k x, the engine's analytic reference system.
 // States x [m], v [m/s]; input f [N]; outputs x, v, a.
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
 
 namespace dydp::blocks {
 namespace {

@@ -2,7 +2,7 @@
 #include <cmath>
 #include <string>
 
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
 
 namespace dydp::blocks {
 namespace {

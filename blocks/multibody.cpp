@@ -18,7 +18,7 @@
 #include <mutex>
 
 #include "blocks/direction_plan.hpp"
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
 #include "generated_models/registry.hpp"
 #include "symbolic/mbs/reduced_dynamics.hpp"
 

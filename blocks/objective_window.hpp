@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "engine/block_check.hpp"
+#include "engine/framework/block_check.hpp"
 
 namespace dydp::blocks {
 

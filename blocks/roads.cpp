@@ -10,7 +10,7 @@
 #include <string>
 
 #include "blocks/time_series.hpp"
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
 
 namespace dydp::blocks {
 namespace {

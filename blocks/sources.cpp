@@ -3,7 +3,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
 
 namespace dydp::blocks {
 namespace {

@@ -7,8 +7,8 @@
 #include <numbers>
 
 #include "blocks/time_series.hpp"
-#include "engine/errors.hpp"
-#include "engine/registry.hpp"
+#include "engine/framework/errors.hpp"
+#include "engine/framework/registry.hpp"
 
 namespace dydp::blocks {
 namespace {

@@ -1,7 +1,7 @@
 // source.table: a column of a CSV file against its time column, linearly interpolated and held
 // constant outside the table. Its values are data, not parameters: its tangent is zero.
 #include "blocks/time_series.hpp"
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
 
 namespace dydp::blocks {
 namespace {

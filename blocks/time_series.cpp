@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <sstream>
 
-#include "engine/recording.hpp"
-#include "engine/errors.hpp"
+#include "engine/framework/errors.hpp"
+#include "io/recording.hpp"
 
 namespace dydp::blocks {
 
@@ -97,9 +97,9 @@ std::vector<TimeSeries> read_time_series(const engine::BlockSettings& s, const s
                                          const std::vector<std::string>& columns,
                                          const std::string& columns_key) {
   const std::string file = s.path(file_key);
-  engine::CsvFile csv;
+  io::CsvFile csv;
   try {
-    csv = engine::read_recording(file);
+    csv = io::read_recording(file);
   } catch (const engine::InputError& e) {
     if (e.line() == 0 && e.field().empty()) s.fail(file_key, "cannot open '" + file + "'");
     throw;

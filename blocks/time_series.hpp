@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/block_settings.hpp"
+#include "engine/framework/block_settings.hpp"
 
 namespace dydp::blocks {
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
 
 namespace dydp::blocks {
 namespace {

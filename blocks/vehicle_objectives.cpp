@@ -4,8 +4,8 @@
 #include <limits>
 
 #include "blocks/objective_window.hpp"
-#include "engine/objective.hpp"
-#include "engine/registry.hpp"
+#include "engine/framework/objective.hpp"
+#include "engine/framework/registry.hpp"
 
 namespace dydp::blocks {
 namespace {

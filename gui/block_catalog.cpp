@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <map>
 
-#include "engine/errors.hpp"
-#include "engine/objective.hpp"
+#include "engine/framework/errors.hpp"
+#include "engine/framework/objective.hpp"
 
 namespace dydp::gui {
 

@@ -6,8 +6,8 @@
 #include <utility>
 #include <vector>
 
-#include "engine/block.hpp"
-#include "engine/registry.hpp"
+#include "engine/framework/block.hpp"
+#include "engine/framework/registry.hpp"
 #include "gui/scene_document.hpp"
 
 namespace dydp::gui {

@@ -12,7 +12,7 @@
 #include <QTabWidget>
 #include <QToolBar>
 
-#include "engine/errors.hpp"
+#include "engine/framework/errors.hpp"
 
 namespace dydp::gui {
 

@@ -10,8 +10,8 @@
 #include <QWidget>
 #include <memory>
 
-#include "engine/diagram.hpp"
-#include "engine/run.hpp"
+#include "engine/analysis/run_result.hpp"
+#include "engine/framework/diagram.hpp"
 
 QT_BEGIN_NAMESPACE
 class QChartView;

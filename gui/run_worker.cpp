@@ -3,7 +3,8 @@
 #include <QCoreApplication>
 #include <QMetaObject>
 
-#include "engine/errors.hpp"
+#include "engine/analysis/run.hpp"
+#include "engine/framework/errors.hpp"
 
 namespace dydp::gui {
 namespace {

@@ -9,8 +9,8 @@
 #include <atomic>
 #include <memory>
 
-#include "engine/diagram.hpp"
-#include "engine/run.hpp"
+#include "engine/analysis/run_result.hpp"
+#include "engine/framework/diagram.hpp"
 
 namespace dydp::gui {
 

@@ -2,8 +2,8 @@
 
 #include "gui/automatic_layout.hpp"
 #include "gui/subsystem_grouping.hpp"
-#include "gui/subsystem_yaml.hpp"
 #include "gui/subsystem_ports.hpp"
+#include "gui/subsystem_yaml.hpp"
 
 #include <QDir>
 #include <QFileInfo>

@@ -10,8 +10,8 @@
 #include <QUndoStack>
 #include <map>
 
-#include "engine/diagram.hpp"
-#include "engine/errors.hpp"
+#include "engine/framework/diagram.hpp"
+#include "engine/framework/errors.hpp"
 #include "gui/block_catalog.hpp"
 #include "gui/scene_document.hpp"
 

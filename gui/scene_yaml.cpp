@@ -7,10 +7,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "engine/errors.hpp"
-#include "engine/output_writer.hpp"
+#include "engine/framework/errors.hpp"
 #include "gui/scene_document.hpp"
 #include "gui/subsystem_yaml.hpp"
+#include "io/files.hpp"
 
 namespace dydp::gui {
 namespace {
@@ -293,7 +293,7 @@ std::string write_scene(const SceneDocument& doc) {
 }
 
 void write_scene_file(const SceneDocument& doc, const std::string& path) {
-  engine::write_file_atomically(path, write_scene(doc));
+  io::write_file_atomically(path, write_scene(doc));
 }
 
 }  // namespace dydp::gui

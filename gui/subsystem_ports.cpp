@@ -2,7 +2,7 @@
 
 #include <optional>
 
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
 
 namespace dydp::gui {
 namespace {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "engine/errors.hpp"
+#include "engine/framework/errors.hpp"
 
 namespace dydp::gui {
 namespace {

@@ -5,8 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "engine/output_writer.hpp"
 #include "io/mat_file.hpp"
+#include "io/output_writer.hpp"
 
 namespace dydp::io {
 namespace {
@@ -55,8 +55,8 @@ void write_run_mat(const std::string& path, const engine::Diagram& d, const engi
   mat.strings("names", names);
   mat.strings("units", units);
   mat.matrix("signals", n, cols, table);
-  mat.json("objectives", nlohmann::ordered_json::parse(engine::objectives_json(r))["objectives"]);
-  mat.json("run", nlohmann::ordered_json::parse(engine::run_json(d, r)));
+  mat.json("objectives", nlohmann::ordered_json::parse(io::objectives_json(r))["objectives"]);
+  mat.json("run", nlohmann::ordered_json::parse(io::run_json(d, r)));
   add_documents(mat, extra);
   mat.commit();
 }

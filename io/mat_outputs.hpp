@@ -7,8 +7,8 @@
 #include <utility>
 #include <vector>
 
-#include "engine/diagram.hpp"
-#include "engine/run.hpp"
+#include "engine/analysis/run_result.hpp"
+#include "engine/framework/diagram.hpp"
 
 namespace dydp::io {
 

@@ -3,8 +3,8 @@
 // settings all have defaults, the ports of a default instance.
 #include <pybind11/stl.h>
 
-#include "engine/consistency_checks.hpp"
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
+#include "engine/scene/consistency_checks.hpp"
 #include "python/bindings.hpp"
 
 namespace py = pybind11;

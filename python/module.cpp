@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <exception>
 
-#include "engine/errors.hpp"
+#include "engine/framework/errors.hpp"
 #include "python/bindings.hpp"
 
 namespace py = pybind11;

@@ -10,10 +10,10 @@
 #include <memory>
 #include <mutex>
 
-#include "engine/diagram.hpp"
-#include "engine/errors.hpp"
-#include "engine/output_writer.hpp"
-#include "engine/run.hpp"
+#include "engine/analysis/run.hpp"
+#include "engine/framework/diagram.hpp"
+#include "engine/framework/errors.hpp"
+#include "io/output_writer.hpp"
 #include "python/bindings.hpp"
 
 namespace py = pybind11;
@@ -83,7 +83,7 @@ RunArrays arrays_of(const engine::Diagram& d, const engine::RunResult& r) {
     a.objectives[py::str(o.name)] = entry;
   }
   // The same statistics, under the same keys, as run.json.
-  a.stats = py::module_::import("json").attr("loads")(engine::run_json(d, r));
+  a.stats = py::module_::import("json").attr("loads")(io::run_json(d, r));
   return a;
 }
 

@@ -6,7 +6,7 @@
 
 #include <filesystem>
 
-#include "engine/screen_study.hpp"
+#include "engine/studies/screen_study.hpp"
 #include "python/bindings.hpp"
 
 namespace py = pybind11;

@@ -6,7 +6,7 @@
 
 #include <filesystem>
 
-#include "engine/sweep.hpp"
+#include "engine/studies/sweep.hpp"
 #include "python/bindings.hpp"
 
 namespace py = pybind11;

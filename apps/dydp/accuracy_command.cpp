@@ -7,9 +7,9 @@
 
 #include "apps/dydp/commands.hpp"
 #include "apps/dydp/gnuplot.hpp"
-#include "engine/accuracy.hpp"
-#include "engine/errors.hpp"
-#include "engine/output_writer.hpp"
+#include "engine/framework/errors.hpp"
+#include "engine/studies/accuracy.hpp"
+#include "io/files.hpp"
 
 namespace dydp::apps {
 namespace {
@@ -60,7 +60,7 @@ int accuracy_command(const AccuracyArgs& args) {
   });
 
   std::filesystem::create_directories(args.out);
-  engine::write_file_atomically(args.out + "/accuracy.csv", accuracy_csv(r));
+  io::write_file_atomically(args.out + "/accuracy.csv", accuracy_csv(r));
 
   std::ostringstream md;
   md << std::setprecision(3);
@@ -113,7 +113,7 @@ int accuracy_command(const AccuracyArgs& args) {
     gp << "unset multiplot\n";
     if (run_gnuplot(args.out, "accuracy", gp.str())) md << "\n![error against CPU time](plots/accuracy.png)\n";
   }
-  engine::write_file_atomically(args.out + "/accuracy.md", md.str());
+  io::write_file_atomically(args.out + "/accuracy.md", md.str());
   std::cout << md.str();
   return 0;
 }

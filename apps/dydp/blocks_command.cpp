@@ -2,8 +2,8 @@
 #include <iomanip>
 
 #include "apps/dydp/commands.hpp"
-#include "engine/consistency_checks.hpp"
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
+#include "engine/scene/consistency_checks.hpp"
 
 namespace dydp::apps {
 

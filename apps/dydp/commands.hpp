@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/run.hpp"
-#include "engine/solver_overrides.hpp"
+#include "engine/analysis/run_result.hpp"
+#include "engine/scene/solver_overrides.hpp"
 
 namespace dydp::apps {
 

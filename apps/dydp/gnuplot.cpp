@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "engine/output_writer.hpp"
+#include "io/files.hpp"
 
 namespace dydp::apps {
 
@@ -19,7 +19,7 @@ std::string file_safe(const std::string& name) {
 bool run_gnuplot(const std::string& dir, const std::string& name, const std::string& script) {
   std::filesystem::create_directories(dir + "/plots");
   const std::string path = dir + "/plots/" + name + ".gp";
-  engine::write_file_atomically(path, script);
+  io::write_file_atomically(path, script);
   return std::system(("gnuplot '" + path + "' 2>'" + dir + "/plots/" + name + ".log'").c_str()) == 0;
 }
 

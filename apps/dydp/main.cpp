@@ -8,8 +8,8 @@
 #include <sstream>
 
 #include "apps/dydp/commands.hpp"
-#include "engine/errors.hpp"
-#include "engine/run_sharing.hpp"
+#include "engine/framework/errors.hpp"
+#include "engine/studies/run_sharing.hpp"
 
 namespace {
 

@@ -12,11 +12,12 @@
 #include <thread>
 
 #include "apps/dydp/commands.hpp"
-#include "engine/recording.hpp"
-#include "engine/errors.hpp"
-#include "engine/output_writer.hpp"
-#include "engine/run.hpp"
+#include "engine/analysis/run.hpp"
+#include "engine/framework/errors.hpp"
+#include "io/files.hpp"
 #include "io/mat_outputs.hpp"
+#include "io/output_writer.hpp"
+#include "io/recording.hpp"
 #include "io/rpc3_outputs.hpp"
 
 namespace dydp::apps {
@@ -76,7 +77,7 @@ class StreamingCsv {
 }  // namespace
 
 int replay_command(const ReplayArgs& args) {
-  const engine::CsvFile recorded = engine::read_recording(args.input);
+  const io::CsvFile recorded = io::read_recording(args.input);
   if (recorded.names.empty() || recorded.names[0] != "t")
     throw engine::InputError(args.input, 1, "t", "the first column must be the time t [s]");
   const std::string input = std::filesystem::absolute(args.input).string();
@@ -126,8 +127,8 @@ int replay_command(const ReplayArgs& args) {
   const engine::RunResult r = engine::run(d, options);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   stream.finish();
-  engine::write_file_atomically(args.out + "/objectives.json", engine::objectives_json(r));
-  engine::write_file_atomically(args.out + "/run.json", engine::run_json(d, r));
+  io::write_file_atomically(args.out + "/objectives.json", io::objectives_json(r));
+  io::write_file_atomically(args.out + "/run.json", io::run_json(d, r));
 
   // Measured responses: columns named after logged signals.
   nlohmann::ordered_json j = {{"input", args.input}, {"simulated_seconds", r.stats.simulated_seconds},
@@ -160,10 +161,10 @@ int replay_command(const ReplayArgs& args) {
     j["validation"][recorded.names[c]] = {{"rms_error", rms}, {"correlation", corr}, {"samples", n}};
     std::cout << "  " << recorded.names[c] << ": rms error " << rms << ", correlation " << corr << "\n";
   }
-  engine::write_file_atomically(args.out + "/replay.json", j.dump(2) + "\n");
+  io::write_file_atomically(args.out + "/replay.json", j.dump(2) + "\n");
   if (args.format == "mat") io::write_run_mat(args.out + "/replay.mat", d, r, {{"replay", j.dump()}});
   if (args.format == "rpc")
-    engine::write_file_atomically(args.out + "/signals.rsp", io::run_rpc3(d, r, engine::Rpc3DataType::floating_point));
+    io::write_file_atomically(args.out + "/signals.rsp", io::run_rpc3(d, r, io::Rpc3DataType::floating_point));
   std::cout << "  results in " << args.out << "/ (signals.csv streamed, objectives.json, run.json, replay.json"
             << (args.format == "mat" ? ", replay.mat" : args.format == "rpc" ? ", signals.rsp" : "") << ")\n";
   return 0;

@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "apps/dydp/gnuplot.hpp"
-#include "engine/output_writer.hpp"
+#include "io/files.hpp"
 
 namespace dydp::apps {
 namespace {
@@ -97,7 +97,7 @@ void write_report(const std::string& dir, const engine::Diagram& d, const engine
   if (ns > 0)
     md << "Lower panels: sensitivities scaled by their parameter's value, p * dS/dp, the change of S "
           "(in its unit) for a 100 % change of p, to first order.\n";
-  engine::write_file_atomically(dir + "/report.md", md.str());
+  io::write_file_atomically(dir + "/report.md", md.str());
 }
 
 }  // namespace dydp::apps

@@ -4,10 +4,10 @@
 
 #include <string>
 
-#include "engine/diagram.hpp"
-#include "engine/run.hpp"
-#include "engine/screen_study.hpp"
-#include "engine/sweep.hpp"
+#include "engine/analysis/run_result.hpp"
+#include "engine/framework/diagram.hpp"
+#include "engine/studies/screen_study.hpp"
+#include "engine/studies/sweep.hpp"
 
 namespace dydp::apps {
 

@@ -7,10 +7,10 @@
 
 #include "apps/dydp/commands.hpp"
 #include "apps/dydp/report.hpp"
-#include "engine/errors.hpp"
-#include "engine/output_writer.hpp"
-#include "engine/run.hpp"
+#include "engine/analysis/run.hpp"
+#include "engine/framework/errors.hpp"
 #include "io/mat_outputs.hpp"
+#include "io/output_writer.hpp"
 
 namespace dydp::apps {
 
@@ -59,7 +59,7 @@ int run_command(const RunArgs& args) {
   const engine::RunResult r = engine::run(d, options);
   if (tty) std::cerr << "\r" << std::string(60, ' ') << "\r";
 
-  engine::write_outputs(args.out, d, r);
+  io::write_outputs(args.out, d, r);
   if (args.format == "mat") io::write_run_mat(args.out + "/run.mat", d, r);
   if (args.report) write_report(args.out, d, r);
 

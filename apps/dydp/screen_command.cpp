@@ -8,10 +8,10 @@
 #include "apps/dydp/commands.hpp"
 #include "apps/dydp/progress_bar.hpp"
 #include "apps/dydp/report.hpp"
-#include "engine/errors.hpp"
-#include "engine/output_writer.hpp"
-#include "engine/run_sharing.hpp"
-#include "engine/screen_study.hpp"
+#include "engine/framework/errors.hpp"
+#include "engine/studies/run_sharing.hpp"
+#include "engine/studies/screen_study.hpp"
+#include "io/files.hpp"
 
 namespace dydp::apps {
 namespace {
@@ -125,9 +125,9 @@ int screen_command(const ScreenArgs& args) {
     std::cerr << "screen: " << r.recorded_before << " runs taken from the records, "
               << r.samples.size() + 1 - r.recorded_before << " run now\n";
 
-  engine::write_file_atomically(args.out + "/screen.csv", measures_csv(r));
-  engine::write_file_atomically(args.out + "/samples.csv", samples_csv(r));
-  engine::write_file_atomically(args.out + "/screen.json", screen_json(r, args.scene).dump(2) + "\n");
+  io::write_file_atomically(args.out + "/screen.csv", measures_csv(r));
+  io::write_file_atomically(args.out + "/samples.csv", samples_csv(r));
+  io::write_file_atomically(args.out + "/screen.json", screen_json(r, args.scene).dump(2) + "\n");
   if (args.report) write_screen_report(args.out, args.scene, r);
 
   std::cout << std::setprecision(4);

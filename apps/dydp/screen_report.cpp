@@ -7,7 +7,7 @@
 
 #include "apps/dydp/gnuplot.hpp"
 #include "apps/dydp/report.hpp"
-#include "engine/output_writer.hpp"
+#include "io/files.hpp"
 
 namespace dydp::apps {
 
@@ -66,7 +66,7 @@ void write_screen_report(const std::string& dir, const std::string& scene, const
       tornado << P - rank << ' ' << std::min(low, high) << ' ' << std::max(low, high) << ' ' << high << " \""
               << label.str() << "\"\n";
     }
-    engine::write_file_atomically(dir + "/plots/tornado_" + name + ".dat", tornado.str());
+    io::write_file_atomically(dir + "/plots/tornado_" + name + ".dat", tornado.str());
     gp << "set output '" << dir << "/plots/tornado_" << name << ".png'\n"
        << "set title '" << r.objectives[o] << ": psi at the ends of each range (mean slope), ranked'\n"
        << "set xlabel 'psi - psi_nominal" << (ou.empty() ? "" : " [" + ou + "]") << "'\nunset ylabel\n"
@@ -87,7 +87,7 @@ void write_screen_report(const std::string& dir, const std::string& scene, const
       for (int i = 0; i < P; ++i) samples << ' ' << s.gradient[o][i];
       samples << '\n';
     }
-    engine::write_file_atomically(dir + "/plots/samples_" + name + ".dat", samples.str());
+    io::write_file_atomically(dir + "/plots/samples_" + name + ".dat", samples.str());
     gp << "set output '" << dir << "/plots/samples_" << name << ".png'\n"
        << "set terminal pngcairo noenhanced size 900," << 40 + 220 * P << " font 'Sans,9'\n"
        << "set multiplot layout " << P << ",2 title '" << r.objectives[o] << " and its derivatives over the samples'\n"
@@ -109,7 +109,7 @@ void write_screen_report(const std::string& dir, const std::string& scene, const
   } else if (!run_gnuplot(dir, "screen", gp.str())) {
     md << "gnuplot failed: see plots/screen.log.\n";
   }
-  engine::write_file_atomically(dir + "/report.md", md.str());
+  io::write_file_atomically(dir + "/report.md", md.str());
 }
 
 }  // namespace dydp::apps

@@ -7,10 +7,10 @@
 
 #include "apps/dydp/commands.hpp"
 #include "apps/dydp/report.hpp"
-#include "engine/errors.hpp"
-#include "engine/output_writer.hpp"
-#include "engine/run_sharing.hpp"
-#include "engine/sweep.hpp"
+#include "engine/framework/errors.hpp"
+#include "engine/studies/run_sharing.hpp"
+#include "engine/studies/sweep.hpp"
+#include "io/files.hpp"
 #include "io/mat_outputs.hpp"
 
 namespace dydp::apps {
@@ -99,8 +99,8 @@ int sweep_command(const SweepArgs& args) {
     }
     j["points"].push_back(p);
   }
-  engine::write_file_atomically(args.out + "/sweep.csv", csv);
-  engine::write_file_atomically(args.out + "/sweep.json", j.dump(2) + "\n");
+  io::write_file_atomically(args.out + "/sweep.csv", csv);
+  io::write_file_atomically(args.out + "/sweep.json", j.dump(2) + "\n");
   if (args.format == "mat") io::write_table_mat(args.out + "/sweep.mat", csv, {{"sweep", j.dump()}});
   if (args.report) write_sweep_report(args.out, args.scene, r, args.delta);
 

@@ -5,13 +5,13 @@
 
 #include "apps/dydp/gnuplot.hpp"
 #include "apps/dydp/report.hpp"
-#include "engine/output_writer.hpp"
+#include "io/files.hpp"
 
 namespace dydp::apps {
 namespace {
 
 /// Data files for gnuplot: one per figure, whitespace separated.
-void write_data(const std::string& path, const std::string& text) { engine::write_file_atomically(path, text); }
+void write_data(const std::string& path, const std::string& text) { io::write_file_atomically(path, text); }
 
 }  // namespace
 
@@ -44,7 +44,7 @@ void write_sweep_report(const std::string& dir, const std::string& scene, const 
 
   if (!have_gnuplot()) {
     md << "gnuplot was not found on the PATH: no plots were made (install gnuplot-nox).\n";
-    engine::write_file_atomically(dir + "/report.md", md.str());
+    io::write_file_atomically(dir + "/report.md", md.str());
     return;
   }
   std::ostringstream gp;
@@ -137,7 +137,7 @@ void write_sweep_report(const std::string& dir, const std::string& scene, const 
     md << "![trajectories](plots/trajectories.png)\n\n![sensitivity surface](plots/sensitivity_surface.png)\n\n";
   }
   if (!run_gnuplot(dir, "sweep", gp.str())) md << "gnuplot failed: see plots/sweep.log.\n";
-  engine::write_file_atomically(dir + "/report.md", md.str());
+  io::write_file_atomically(dir + "/report.md", md.str());
 }
 
 }  // namespace dydp::apps

@@ -9,8 +9,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "engine/diagram.hpp"
-#include "engine/run.hpp"
+#include "engine/analysis/run.hpp"
+#include "engine/framework/diagram.hpp"
 
 namespace {
 

@@ -8,8 +8,8 @@
 #include <cmath>
 #include <string>
 
-#include "engine/diagram.hpp"
-#include "engine/run.hpp"
+#include "engine/analysis/run.hpp"
+#include "engine/framework/diagram.hpp"
 
 namespace {
 

@@ -1,6 +1,6 @@
 // Generated dynamics against Orocos KDL on serial chains (chain9: 9 joints, one prismatic, offset
 // and inclined bodies; chain200: 200 revolutes). The KDL chain is built from the same model file
-// (kdl_chain.hpp; tests/mbs/test_kdl.cpp checks that both agree). Three comparisons:
+// (kdl_chain.hpp; tests/symbolic/mbs/kdl_test.cpp checks that both agree). Three comparisons:
 //   inverse dynamics: the generated residual (M qdd + c, lam = 0, no inputs) vs ChainIdSolver_RNE;
 //   mass matrix:      the generated inertial tangent seeded with the n identity columns
 //                     (generated_mass_matrix below) vs ChainDynParam::JntToMass;
@@ -128,7 +128,7 @@ struct Setup {
       s.kqdd.data = s.qdd;
     }
   }
-  // Empty when both sides compute the same thing at the first state (tests/mbs/test_kdl.cpp
+  // Empty when both sides compute the same thing at the first state (tests/symbolic/mbs/kdl_test.cpp
   // checks it more closely).
   std::string check() {
     if (g.m != 0 || g.inputs != 0 || reduced.nu() != n) return "not an unconstrained chain without inputs";

@@ -8,7 +8,7 @@
 #include <sstream>
 #include <string>
 
-#include "engine/diagram.hpp"
+#include "engine/framework/diagram.hpp"
 
 namespace dydp::gui::testing {
 

@@ -11,8 +11,8 @@
 #include <QtTest>
 #include <cmath>
 
-#include "engine/diagram.hpp"
-#include "engine/run.hpp"
+#include "engine/analysis/run.hpp"
+#include "engine/framework/diagram.hpp"
 #include "gui/main_window.hpp"
 
 using namespace dydp::gui;

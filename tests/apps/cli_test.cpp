@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
 #include "tests/apps/dydp_process.hpp"
 #include "tests/temp_folder_test.hpp"
 

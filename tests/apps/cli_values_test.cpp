@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/csv.hpp"
+#include "io/csv.hpp"
 #include "tests/apps/dydp_process.hpp"
 #include "tests/engine/msd_closed_form.hpp"
 #include "tests/grid_error.hpp"
@@ -58,7 +58,7 @@ TEST_F(CliValues, RunOfTheShippedMsdSceneMatchesTheClosedForm) {
   const fs::path out = dir_ / "run";
   const ProcessResult r = dydp("run " + quote(msd_scene()) + " --out " + quote(out.string()));
   ASSERT_EQ(r.status, 0) << r.err;
-  const engine::CsvFile csv = engine::read_csv((out / "signals.csv").string());
+  const io::CsvFile csv = io::read_csv((out / "signals.csv").string());
   const std::vector<double>& t = column(csv, "t");
   ASSERT_EQ(t.size(), 1001u);
 
@@ -97,7 +97,7 @@ TEST_F(CliValues, SweepDeltaColumnIsTheDerivativeTimesTheStep) {
   const ProcessResult r = dydp("sweep " + quote(msd_scene()) + " --param damping --range 0.5:2.5:3 --delta 0.1 --out " +
                                quote(out.string()));
   ASSERT_EQ(r.status, 0) << r.err;
-  const engine::CsvFile csv = engine::read_csv((out / "sweep.csv").string());
+  const io::CsvFile csv = io::read_csv((out / "sweep.csv").string());
   const std::vector<double>& c = column(csv, "damping");
   ASSERT_EQ(c.size(), 3u);
   const std::vector<double>& psi = column(csv, "x_rms");

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/csv.hpp"
+#include "io/csv.hpp"
 #include "tests/temp_folder_test.hpp"
 
 namespace dydp::test {
@@ -79,7 +79,7 @@ inline std::string scene_copy_text(const std::filesystem::path& scene) {
 }
 
 /// A column of a CSV file the program wrote, by name; throws when it is missing.
-inline const std::vector<double>& column(const engine::CsvFile& csv, const std::string& name) {
+inline const std::vector<double>& column(const io::CsvFile& csv, const std::string& name) {
   const int c = csv.find(name);
   if (c < 0) throw std::runtime_error(csv.path + ": no column " + name);
   return csv.columns[static_cast<size_t>(c)];

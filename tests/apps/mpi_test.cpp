@@ -2,7 +2,7 @@
 // the same numbers, bit for bit, and rank 0 alone writes the results and prints.
 #include <cstdlib>
 
-#include "engine/run_sharing.hpp"
+#include "engine/studies/run_sharing.hpp"
 #include "tests/apps/dydp_process.hpp"
 
 namespace dydp::test {

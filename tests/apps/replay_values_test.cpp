@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/csv.hpp"
+#include "io/csv.hpp"
 #include "tests/apps/dydp_process.hpp"
 #include "tests/grid_error.hpp"
 
@@ -96,7 +96,7 @@ TEST_F(ReplayValues, ReplayFollowsTheRecordingNotTheRig) {
   ProcessResult r = dydp("run " + quote(write("sines_250.yaml", sine_scene(0.004))) + " --no-sens --out " +
                          quote(sines_250.string()));
   ASSERT_EQ(r.status, 0) << r.err;
-  const engine::CsvFile measured = engine::read_csv((sines_250 / "signals.csv").string());
+  const io::CsvFile measured = io::read_csv((sines_250 / "signals.csv").string());
   const std::vector<double>& t_rec = column(measured, "t");
   ASSERT_EQ(t_rec.size(), 751u);
 
@@ -114,7 +114,7 @@ TEST_F(ReplayValues, ReplayFollowsTheRecordingNotTheRig) {
   r = dydp("replay " + quote(write("rig.yaml", rig_scene())) + " --input " + quote(recording) +
            " --solver bdf --out " + quote(replay.string()));
   ASSERT_EQ(r.status, 0) << r.err;
-  const engine::CsvFile replayed = engine::read_csv((replay / "signals.csv").string());
+  const io::CsvFile replayed = io::read_csv((replay / "signals.csv").string());
   const std::vector<double>& t = column(replayed, "t");
   ASSERT_EQ(t.size(), 1501u);
 
@@ -139,7 +139,7 @@ TEST_F(ReplayValues, ReplayFollowsTheRecordingNotTheRig) {
   const fs::path sines = dir_ / "sines";
   r = dydp("run " + quote(write("sines.yaml", sine_scene(0.002))) + " --out " + quote(sines.string()));
   ASSERT_EQ(r.status, 0) << r.err;
-  const engine::CsvFile independent = engine::read_csv((sines / "signals.csv").string());
+  const io::CsvFile independent = io::read_csv((sines / "signals.csv").string());
   ASSERT_EQ(column(independent, "t").size(), t.size());
   for (const std::string body : {"body_front.x", "body_rear.x"}) {
     EXPECT_LT(grid_error(column(replayed, body), column(independent, body)), 1e-4) << body;

@@ -166,7 +166,7 @@ TEST_F(Screen, MeasuresFollowFromTheSamplesAndGradientsFromSingleRuns) {
   const ProcessResult r =
       dydp("screen " + quote(scene) + " --params stiffness,damping --samples 16 --out " + quote(out.string()));
   ASSERT_EQ(r.status, 0) << r.err;
-  const engine::CsvFile samples = engine::read_csv((out / "samples.csv").string());
+  const io::CsvFile samples = io::read_csv((out / "samples.csv").string());
   const json j = json::parse(read_text(out / "screen.json"));
   const json& x = j["objectives"]["x_rms"];
   const std::vector<double>& k = column(samples, "stiffness");

@@ -19,8 +19,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/csv.hpp"
-#include "engine/registry.hpp"
+#include "engine/framework/registry.hpp"
+#include "io/csv.hpp"
 #include "tests/apps/dydp_process.hpp"
 
 namespace dydp::test {
@@ -62,7 +62,7 @@ void PrintTo(const StressCase& c, std::ostream* os) { *os << c.scene; }
 
 fs::path stress_scene(const std::string& name) { return source_path("scenarios/stress/" + name + ".yaml"); }
 
-double value_at(const engine::CsvFile& csv, const std::string& name, double t) {
+double value_at(const io::CsvFile& csv, const std::string& name, double t) {
   const auto& ts = column(csv, "t");
   const size_t k = static_cast<size_t>(std::min_element(ts.begin(), ts.end(), [t](double a, double b) {
                                          return std::fabs(a - t) < std::fabs(b - t);
@@ -115,7 +115,7 @@ TEST_P(StressOutcomes, OutcomeIsTheStatedOne) {
   const ProcessResult r = dydp("run " + quote(stress_scene(c.scene).string()) + " --out " + quote(out.string()));
   if (c.completes) {
     ASSERT_EQ(r.status, 0) << r.err;
-    const engine::CsvFile csv = engine::read_csv((out / "signals.csv").string());
+    const io::CsvFile csv = io::read_csv((out / "signals.csv").string());
     for (size_t i = 0; i < csv.names.size(); ++i)
       for (double v : csv.columns[i]) ASSERT_TRUE(std::isfinite(v)) << csv.names[i];
     const json objectives = json::parse(read_text(out / "objectives.json"))["objectives"];
@@ -146,13 +146,13 @@ class StressClaims : public DydpProcessTest {
   StressClaims() : DydpProcessTest("dydp_stress_claims_") {}
 
   /// Runs a copy of a stress scene (edited by `edit`) without sensitivities; its signals.
-  engine::CsvFile run_copy(const std::string& name, const std::function<std::string(std::string)>& edit) {
+  io::CsvFile run_copy(const std::string& name, const std::function<std::string(std::string)>& edit) {
     const std::string scene = write(name + ".yaml", edit(scene_copy_text(stress_scene(name))));
     const fs::path out = dir_ / name;
     const ProcessResult r = dydp("run " + quote(scene) + " --no-sens --out " + quote(out.string()));
     EXPECT_EQ(r.status, 0) << r.err;
     if (r.status != 0) throw std::runtime_error(name + " did not run: " + r.err);
-    return engine::read_csv((out / "signals.csv").string());
+    return io::read_csv((out / "signals.csv").string());
   }
 };
 
@@ -161,7 +161,7 @@ class StressClaims : public DydpProcessTest {
 // (after the 1 s ramp that ends at 1.5 s), the lateral acceleration over the scene's objective
 // window [4, 5] s.
 TEST_F(StressClaims, CorneringSaturationCoastsAndSaturatesAsItsHeaderSays) {
-  const engine::CsvFile csv = run_copy("cornering_saturation", [](std::string s) { return s; });
+  const io::CsvFile csv = run_copy("cornering_saturation", [](std::string s) { return s; });
   const auto& t = column(csv, "t");
   EXPECT_NEAR(value_at(csv, "car.body_vx", 0.0), 25.0, 1e-3);
   EXPECT_NEAR(value_at(csv, "car.body_vx", t.back()), 17.0, 1.0);
@@ -180,7 +180,7 @@ TEST_F(StressClaims, CorneringSaturationCoastsAndSaturatesAsItsHeaderSays) {
 // cornering_wheelspin's header: "at 2 s the car spins (yaw rate 1.4 rad/s, rear slip angle
 // 0.49 rad, 10 m/s sideways)": its first 2.1 s (objective windows moved inside the run).
 TEST_F(StressClaims, CorneringWheelspinSpinsAtTwoSecondsAsItsHeaderSays) {
-  const engine::CsvFile csv = run_copy("cornering_wheelspin", [](std::string s) {
+  const io::CsvFile csv = run_copy("cornering_wheelspin", [](std::string s) {
     s = DydpProcessTest::replaced(s, "stop: 5.0", "stop: 2.1");
     while (s.find("window: [4.0, 5.0]") != std::string::npos)
       s.replace(s.find("window: [4.0, 5.0]"), 18, "window: [1.5, 2.1]");
@@ -196,7 +196,7 @@ TEST_F(StressClaims, CorneringWheelspinSpinsAtTwoSecondsAsItsHeaderSays) {
 // 0.6 / 25 = 24 ms, at full depth between the 50 mm edges (0.802 to 0.822 s); the tyre leaves
 // the road (its force falls below 1 % of the static load) while over it.
 TEST_F(StressClaims, PotholeIsFiftyMillimetresDeepAndTheWheelLiftsOff) {
-  const engine::CsvFile csv = run_copy("pothole_lift_off", [](std::string s) {
+  const io::CsvFile csv = run_copy("pothole_lift_off", [](std::string s) {
     return DydpProcessTest::replaced(s, "outputs: [body_az.y,", "outputs: [road_z.y, body_az.y,");
   });
   const auto& t = column(csv, "t");
@@ -224,7 +224,7 @@ TEST_F(StressClaims, PotholeIsFiftyMillimetresDeepAndTheWheelLiftsOff) {
 // tiny_chambers stops at the compression chamber's end: over its first 4.3 ms the stroke runs
 // towards -V_comp0 / A_p = -0.5e-6 / (pi / 4 0.032^2) = -0.622 mm, by hand, and not beyond.
 TEST_F(StressClaims, TinyChambersRunOutOfStrokeAtTheCompressionEnd) {
-  const engine::CsvFile csv = run_copy("tiny_chambers", [](std::string s) {
+  const io::CsvFile csv = run_copy("tiny_chambers", [](std::string s) {
     s = DydpProcessTest::replaced(s, "stop: 3.0, output_step: 0.005", "stop: 0.0043, output_step: 0.0001");
     while (s.find("window: [1.0, 3.0]") != std::string::npos)
       s.replace(s.find("window: [1.0, 3.0]"), 18, "window: [0.0, 0.0043]");

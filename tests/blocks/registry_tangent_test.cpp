@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "generated_models/registry.hpp"
-#include "tests/mbs/oracle_compare.hpp"
 #include "tests/blocks/scene_helpers.hpp"
 #include "tests/blocks/tangent_check.hpp"
+#include "tests/symbolic/mbs/oracle_compare.hpp"
 
 namespace dydp::test {
 namespace {

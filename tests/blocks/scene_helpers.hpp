@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
-#include "engine/diagram.hpp"
-#include "engine/run.hpp"
+#include "engine/analysis/run.hpp"
+#include "engine/framework/diagram.hpp"
 
 namespace dydp::test {
 

@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "engine/block.hpp"
-#include "engine/objective.hpp"
-#include "engine/registry.hpp"
+#include "engine/framework/block.hpp"
+#include "engine/framework/objective.hpp"
+#include "engine/framework/registry.hpp"
 
 namespace dydp::test {
 

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "engine/diagram.hpp"
+#include "engine/framework/diagram.hpp"
 
 namespace dydp::engine::test {
 

@@ -10,8 +10,8 @@
 #include <utility>
 #include <vector>
 
-#include "engine/diagram.hpp"
-#include "engine/errors.hpp"
+#include "engine/framework/diagram.hpp"
+#include "engine/framework/errors.hpp"
 #include "tests/temp_folder_test.hpp"
 
 namespace dydp::test {

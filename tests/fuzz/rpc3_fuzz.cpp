@@ -4,15 +4,15 @@
 #include <cmath>
 #include <cstdint>
 
-#include "engine/errors.hpp"
-#include "engine/rpc3.hpp"
+#include "engine/framework/errors.hpp"
+#include "io/rpc3.hpp"
 #include "tests/fuzz/fuzz_input_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static dydp::fuzz::InputFile file(".rsp");
   const std::string& path = file.write(data, size);
   try {
-    const dydp::engine::Rpc3File f = dydp::engine::read_rpc3(path);
+    const dydp::io::Rpc3File f = dydp::io::read_rpc3(path);
     const size_t points = static_cast<size_t>(f.frames) * f.points_per_frame;
     if (f.channels.empty() || points * 2 > size) __builtin_trap();  // more samples than bytes
     for (const auto& c : f.channels) {

@@ -12,8 +12,8 @@
 #include <filesystem>
 #include <string>
 
-#include "engine/diagram.hpp"
-#include "engine/errors.hpp"
+#include "engine/framework/diagram.hpp"
+#include "engine/framework/errors.hpp"
 #include "tests/fuzz/fuzz_input_file.hpp"
 
 namespace {

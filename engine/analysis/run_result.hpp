@@ -1,0 +1,90 @@
+// What a run takes and gives: its options, the recorded results (signals and their
+// sensitivities on the output grid, objectives with d(psi)/dp) and the statistics that go to
+// run.json. Every integrator fills these; engine/analysis/run.hpp picks the integrator.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "engine/framework/diagram.hpp"
+
+namespace dydp::engine {
+
+struct RunResult;
+
+struct RunOptions {
+  bool sensitivities = true;                  ///< false: --no-sens, no tangent work at all
+  /// CVODES only: true replaces the diagram's tangent pass by CVODES' own difference-quotient
+  /// sensitivity right-hand side (for comparison; the default is the exact tangent pass).
+  bool difference_quotient_sensitivities = false;
+  std::function<void(double t)> progress;     ///< called at every output time
+  /// Called at every output time with the result so far (its last sample is the new one):
+  /// for streaming outputs. An exception thrown here ends the run.
+  std::function<void(const RunResult&)> on_sample;
+};
+
+/// A state that limited the step size (see engine/step_limiters.hpp).
+struct LimitingState {
+  std::string state;   ///< block.state
+  long steps = 0;      ///< accepted steps at which its weighted local error was the largest
+  double share = 0.0;  ///< steps / all counted steps
+};
+
+struct RunStats {
+  std::string method;
+  double rtol = 0.0, atol = 0.0, step = 0.0;
+  long steps = 0;
+  long rhs_evals = 0;             ///< value passes for state derivatives
+  long sens_rhs_evals = 0;        ///< tangent passes for the sensitivity equations
+  long jac_evals = 0;             ///< Jacobians (each one tangent pass over jacobian_colours directions)
+  /// Directions of a Jacobian's tangent pass: the colours of its columns (columns whose rows do
+  /// not meet share one, engine/jacobian_colouring.hpp), the states when none can share.
+  int jacobian_colours = 0;
+  long local_jac_evals = 0;       ///< refreshes of the blocks' own diagonal Jacobian blocks only
+  long error_test_failures = 0;
+  long nonlinear_iterations = 0;
+  long nonlinear_failures = 0;    ///< corrector convergence failures (step retried smaller)
+  long substeps = 0;              ///< fixed-step schemes: steps taken as two halves (their Newton
+                                  ///< iteration failed at the full step)
+  double cpu_seconds = 0.0;
+  double simulated_seconds = 0.0;
+  double realtime_factor = 0.0;   ///< simulated seconds per CPU second
+  std::vector<std::string> warnings;
+  /// BDF and Adams: the highest order allowed (solver.max_order, else the method's own limit);
+  /// steps_per_order[k - 1] counts the accepted steps taken at order k.
+  int max_order = 0;
+  std::vector<long> steps_per_order;
+  /// Variable-step solvers: the states that limited the step most often, most often first.
+  std::vector<LimitingState> limiting_states;
+};
+
+struct ObjectiveResult {
+  std::string name;
+  std::string unit;                 ///< of value (sensitivities: unit per unit of the parameter)
+  double value = 0.0;
+  std::vector<double> sensitivity;  ///< one per sensitivity direction
+};
+
+/// "a / b" for the unit of a derivative da/db ("" when both are unknown).
+std::string unit_per(const std::string& a, const std::string& b);
+
+struct RunResult {
+  std::vector<std::string> signal_names;       ///< logged scalars
+  std::vector<std::string> sensitivity_names;  ///< the directions (empty without sensitivities)
+  std::vector<double> t;                       ///< output grid
+  std::vector<double> values;                  ///< values[k * nsig + i]
+  std::vector<double> tangents;                ///< tangents[(k * ns + d) * nsig + i]
+  std::vector<double> final_state;
+  std::vector<ObjectiveResult> objectives;
+  RunStats stats;
+
+  int num_signals() const { return static_cast<int>(signal_names.size()); }
+  double value(int k, int i) const { return values[k * num_signals() + i]; }
+  double tangent(int k, int d, int i) const {
+    return tangents[(k * static_cast<int>(sensitivity_names.size()) + d) * num_signals() + i];
+  }
+  int signal_index(const std::string& name) const;
+};
+
+}  // namespace dydp::engine

@@ -1,0 +1,100 @@
+// The diagram's passes over its blocks in evaluation order: the value pass (outputs), state
+// derivatives and quadrature integrands, and the tangent pass (their forward derivatives for
+// many directions at once). Solvers call these; nothing here knows which solver runs.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "engine/framework/diagram.hpp"
+
+namespace dydp::engine {
+
+class Evaluator {
+ public:
+  /// `directions`: the sensitivity directions whose parameter seeds the tangent pass applies
+  /// (the diagram's sensitivities, or none for a run without them).
+  Evaluator(const Diagram& d, bool with_sensitivities);
+
+  int num_directions() const { return ns_; }
+
+  /// Evaluates with these scene parameter values (indexed like Diagram::parameters) instead
+  /// of the diagram's, for CVODES' difference-quotient sensitivities, which perturb them.
+  void use_parameter_values(const double* scene_values);
+  void set_segment_start(double t) { segment_start_ = t; valid_ = false; }
+
+  /// x(t0) and, for the sensitivity directions, dx(t0)/dp (ld = num_states).
+  void initial_state(double t0, double* x0);
+  void initial_state_tangent(double t0, const double* x0, DirView dx0);
+
+  /// Value pass: every kept block's outputs at (t, x). Cached: repeated calls are free.
+  void outputs(double t, const double* x);
+  /// xdot = f(t, x) (runs the value pass if needed).
+  void derivatives(double t, const double* x, double* xdot);
+  /// Quadrature integrands at (t, x).
+  void quadratures(double t, const double* x, double* qdot);
+
+  /// Tangent pass for nd directions: state seeds dx (ld = num_states, null data: zero) and, when
+  /// with_params, the sensitivity parameter seeds (then nd must be num_directions()). Fills the
+  /// signal tangents and, where given, dxdot (ld = num_states) and dqdot (ld = num_quadratures).
+  void tangents(double t, const double* x, int nd, ConstDirView dx, bool with_params,
+                DirView dxdot, DirView dqdot);
+
+  /// Overwrites the diagonal block d(xdot_b)/dx_b of jac (column-major, leading dimension ld)
+  /// for every block that provides Block::local_jacobian, at (t, x). False when none does.
+  bool local_jacobians(double t, const double* x, double* jac, int ld);
+
+  /// The states of the blocks that gave a local Jacobian in the last local_jacobians call:
+  /// (first state, count) per block, in state order.
+  const std::vector<std::pair<int, int>>& local_state_ranges() const { return local_ranges_; }
+  /// For those blocks alone, at the states x (a whole state vector; other blocks' states are not
+  /// read) with their inputs as the last value pass left them: their rows of xdot, their
+  /// diagonal blocks of d(xdot)/dx (like local_jacobians), and their rows of the tangent for
+  /// state seeds dx, the input seeds of the last tangent pass and, when with_params, the
+  /// parameter seeds. Nothing else is evaluated, so a solver can iterate on these blocks' states
+  /// at a fixed point of the rest (Rosenbrock-W's local stages, docs/engine.md).
+  void local_derivatives(double t, const double* x, double* xdot);
+  void local_jacobians_held(double t, const double* x, double* jac, int ld);
+  void local_derivatives_tangent(double t, const double* x, int nd, ConstDirView dx, bool with_params, DirView dxdot);
+
+  const std::vector<double>& signals() const { return sig_; }
+  /// Signal tangents of the last tangent pass: element (i, d) at [d * num_signals + i].
+  const std::vector<double>& signal_tangents() const { return dsig_; }
+
+  /// Names the first block whose outputs or derivatives (xdot, may be null) are not finite;
+  /// empty when all are.
+  std::string find_nonfinite(const double* xdot) const;
+  /// Fast check that every signal and xdot[0, num_states) is finite.
+  bool all_finite(const double* xdot) const;
+
+ private:
+  Eval eval_for(const Node& n, int index, double t, const double* x) const;
+  Seeds seeds_for(const Node& n, int index, int nd, ConstDirView dx, bool with_params);
+
+  const Diagram& d_;
+  int ns_ = 0;
+  double segment_start_ = 0.0;
+  std::vector<double> sig_, dsig_;
+  std::vector<double> pseed_;          ///< per node np x ns, d-major, concatenated
+  std::vector<int> pseed_offset_;
+  std::vector<bool> driven_;           ///< node has a parameter driven by a direction
+  std::vector<std::vector<double>> p_override_;  ///< per node, when use_parameter_values was called
+  std::vector<bool> time_only_;        ///< node has neither inputs nor states: a source
+  std::vector<bool> source_valid_;     ///< its outputs are those at source_t_
+  std::vector<double> source_t_, source_segment_;
+  std::vector<bool> zero_tangent_;     ///< per output port (at its signal offset): its tangents
+                                       ///< are zero in this tangent pass
+  std::vector<const double*> u_;       ///< input pointers, per node concatenated
+  std::vector<int> u_offset_;
+  std::vector<double*> y_;             ///< output pointers, per node concatenated
+  std::vector<ConstDirView> du_;       ///< scratch for a node's input seed views
+  std::vector<DirView> dy_;            ///< scratch for a node's output seed views
+  std::vector<double> zero_x_;         ///< seeds for state-less evaluations
+  bool valid_ = false;
+  std::vector<std::pair<int, int>> local_ranges_;  ///< see local_state_ranges
+  std::vector<int> local_nodes_;                   ///< their nodes
+  double last_t_ = 0.0;
+  std::vector<double> last_x_;
+};
+
+}  // namespace dydp::engine

@@ -1,0 +1,230 @@
+#include "engine/studies/screen_study.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "engine/analysis/run.hpp"
+#include "engine/framework/errors.hpp"
+#include "engine/studies/run_sharing.hpp"
+#include "engine/studies/sobol_points.hpp"
+#include "io/files.hpp"
+
+namespace dydp::engine {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::ordered_json;
+
+std::string runs_folder(const std::string& out) { return out + "/runs"; }
+
+/// FNV-1a of a file's bytes: a record of another scene (or subsystem) text is not resumed.
+std::string file_digest(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  unsigned long long h = 1469598103934665603ull;
+  for (unsigned char c : text.str()) h = (h ^ c) * 1099511628211ull;
+  char buffer[17];
+  std::snprintf(buffer, sizeof buffer, "%016llx", h);
+  return buffer;
+}
+
+Diagram load(const ScreenSpec& spec) {
+  Diagram d = load_scene(spec.scene, spec.overrides);
+  apply_solver_overrides(d, spec.solver);
+  return d;
+}
+
+/// What makes two invocations the same study (the number of samples aside: the first N points
+/// of the Sobol' sequence do not depend on N, so a study may be resumed with more samples).
+ordered_json identity(const ScreenSpec& spec, const ScreenResult& r, const Diagram& d) {
+  ordered_json j;
+  j["scene"] = fs::absolute(spec.scene).lexically_normal().string();
+  j["scene_digest"] = file_digest(spec.scene);
+  // the subsystem files the scene includes: an edited corner is another study too
+  std::set<std::string> included;
+  for (const Node& n : d.nodes)
+    if (!n.file.empty()) included.insert(fs::absolute(n.file).lexically_normal().string());
+  for (const std::string& file : included) j["subsystem_digests"][file] = file_digest(file);
+  j["set"] = ordered_json::array();
+  for (const auto& [name, value] : spec.overrides) j["set"].push_back(name + "=" + value);
+  j["solver"] = {{"method", d.solver.method}, {"rtol", d.solver.rtol}, {"atol", d.solver.atol}, {"step", d.solver.step}};
+  for (const auto& range : r.ranges)
+    j["parameters"].push_back({{"name", range.name}, {"lower", range.lower}, {"upper", range.upper},
+                               {"nominal", range.nominal}});
+  return j;
+}
+
+std::string encode(const ScreenRun& run) {
+  ordered_json j = {{"index", run.index}, {"p", run.p}, {"psi", run.psi}, {"gradient", run.gradient},
+                    {"cpu_seconds", run.cpu_seconds}, {"steps", run.steps}};
+  return j.dump() + "\n";
+}
+
+ScreenRun decode(const std::string& text) {
+  const auto j = nlohmann::json::parse(text);
+  ScreenRun run;
+  run.index = j.at("index");
+  run.p = j.at("p").get<std::vector<double>>();
+  run.psi = j.at("psi").get<std::vector<double>>();
+  run.gradient = j.at("gradient").get<std::vector<std::vector<double>>>();
+  run.cpu_seconds = j.at("cpu_seconds");
+  run.steps = j.at("steps");
+  return run;
+}
+
+}  // namespace
+
+std::string screen_record_path(const std::string& out, int index) {
+  char name[32];
+  std::snprintf(name, sizeof name, "/run_%05d.json", index);
+  return runs_folder(out) + name;
+}
+
+ScreenResult screen(const ScreenSpec& spec) {
+  // Validate on every rank (the same scene gives the same verdict), before any run starts.
+  const Diagram probe = load(spec);
+  if (spec.parameters.empty()) throw InputError("--params", 0, "", "name at least one parameter");
+  if (spec.samples < 2) throw InputError("--samples", 0, std::to_string(spec.samples), "needs at least 2 samples");
+  if (probe.objectives.empty())
+    throw InputError(spec.scene, 0, "outputs", "a screening study needs at least one objective among the outputs");
+  if (static_cast<int>(spec.parameters.size()) > sobol_max_dimension())
+    throw InputError("--params", 0, "", "at most " + std::to_string(sobol_max_dimension()) + " parameters");
+  ScreenResult r;
+  std::vector<int> indices;
+  for (const std::string& name : spec.parameters) {
+    const int i = probe.find_parameter(name);
+    if (i < 0)
+      throw InputError("--params", 0, name, "no scene parameter or declared direction of that name in " + spec.scene);
+    if (std::find(indices.begin(), indices.end(), i) != indices.end())
+      throw InputError("--params", 0, name, "listed twice");
+    const SceneParameter& sp = probe.parameters[i];
+    if (!std::isfinite(sp.lower) || !std::isfinite(sp.upper) || !(sp.lower < sp.upper))
+      throw InputError(spec.scene, sp.line, (sp.direction_list.empty() ? "parameters." : sp.direction_list + ".") + name,
+                       "a screened parameter needs a finite range [low, high] with low < high (range: [" +
+                           format_number(sp.lower) + ", " + format_number(sp.upper) + "])");
+    indices.push_back(i);
+    r.ranges.push_back({name, sp.lower, sp.upper, sp.value});
+    r.units.push_back(sp.unit);
+  }
+  {
+    Diagram check = load(spec);
+    check.set_sensitivities(indices);
+  }
+  for (int o : probe.objectives) {
+    r.objectives.push_back(probe.nodes[o].name);
+    r.objective_units.push_back(probe.objective_unit(probe.nodes[o]));
+  }
+  const int P = static_cast<int>(indices.size()), N = spec.samples, O = static_cast<int>(r.objectives.size());
+  const std::vector<std::vector<double>> unit_points = sobol_points(P, N);
+  auto point = [&](int index) {
+    std::vector<double> p(P);
+    for (int i = 0; i < P; ++i)
+      p[i] = index == 0 ? r.ranges[i].nominal
+                        : r.ranges[i].lower + (r.ranges[i].upper - r.ranges[i].lower) * unit_points[index - 1][i];
+    return p;
+  };
+
+  // Rank 0 owns the folder: it reads earlier records and writes every new one.
+  const bool writer = world_rank() == 0;
+  std::vector<ScreenRun> runs(N + 1);
+  std::vector<bool> have(N + 1, false);
+  const ordered_json id = identity(spec, r, probe);
+  const std::string folder = runs_folder(spec.out);
+  if (writer) {
+    const std::string id_path = folder + "/study.json";
+    if (spec.resume && fs::exists(id_path)) {
+      std::ifstream in(id_path);
+      ordered_json earlier;
+      try {
+        earlier = ordered_json::parse(in);
+      } catch (const std::exception&) {
+        throw InputError(id_path, 0, "", "not a study record (resume needs the study.json of an earlier screen)");
+      }
+      for (const auto& [key, value] : id.items())
+        if (!earlier.contains(key) || earlier[key] != value)
+          throw InputError(id_path, 0, key, "the recorded study differs from this one in '" + key +
+                                                "': --resume continues the same study only (choose another --out)");
+      for (int k = 0; k <= N; ++k) {
+        const std::string path = screen_record_path(spec.out, k);
+        if (!fs::exists(path)) continue;
+        std::ifstream record(path, std::ios::binary);
+        std::ostringstream text;
+        text << record.rdbuf();
+        ScreenRun run;
+        try {
+          run = decode(text.str());
+        } catch (const std::exception& e) {
+          throw InputError(path, 0, "", std::string("unreadable run record: ") + e.what());
+        }
+        if (run.index != k || run.p != point(k) || static_cast<int>(run.psi.size()) != O ||
+            static_cast<int>(run.gradient.size()) != O)
+          throw InputError(path, 0, "", "the record does not belong to run " + std::to_string(k) + " of this study");
+        runs[k] = std::move(run);
+        have[k] = true;
+        ++r.recorded_before;
+      }
+    } else {
+      // A fresh study: records of an earlier one would be mistaken for this one's.
+      fs::remove_all(folder);
+    }
+    fs::create_directories(folder);
+    io::write_file_atomically(id_path, id.dump(2) + "\n");
+  }
+
+  std::vector<int> todo;
+  for (int k = 0; k <= N; ++k)
+    if (!have[k]) todo.push_back(k);
+
+  auto run_one = [&](int k) {
+    Diagram d = load(spec);
+    const std::vector<double> p = point(k);
+    for (int i = 0; i < P; ++i) d.set_parameter(indices[i], p[i]);
+    d.set_sensitivities(indices);
+    const RunResult result = run(d);
+    ScreenRun sr;
+    sr.index = k;
+    sr.p = p;
+    for (const auto& obj : result.objectives) {
+      sr.psi.push_back(obj.value);
+      sr.gradient.push_back(obj.sensitivity);
+    }
+    sr.cpu_seconds = result.stats.cpu_seconds;
+    sr.steps = result.stats.steps;
+    return encode(sr);
+  };
+  int done = 0;
+  const int to_do = static_cast<int>(todo.size());
+  auto record = [&](int k, const std::string& text) {
+    io::write_file_atomically(screen_record_path(spec.out, k), text);
+    // The study's numbers come from the record as written: a resumed study reads the same.
+    runs[k] = decode(text);
+    have[k] = true;
+    if (spec.progress) spec.progress(++done, to_do);
+  };
+  share_runs(todo, run_one, record, spec.threads > 0 ? spec.threads : (world_size() > 1 ? 1 : 0));
+  if (!writer) return r;
+
+  r.nominal = runs[0];
+  r.samples.assign(runs.begin() + 1, runs.end());
+  for (int o = 0; o < O; ++o) {
+    ScreeningData data;
+    for (const ScreenRun& s : r.samples) {
+      data.psi.push_back(s.psi[o]);
+      data.gradient.push_back(s.gradient[o]);
+    }
+    data.nominal_psi = r.nominal.psi[o];
+    data.nominal_gradient = r.nominal.gradient[o];
+    r.estimates.push_back(estimate_screening(r.ranges, data));
+  }
+  r.complete = true;
+  return r;
+}
+
+}  // namespace dydp::engine

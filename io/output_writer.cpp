@@ -1,0 +1,97 @@
+#include "io/output_writer.hpp"
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "io/files.hpp"
+
+namespace dydp::io {
+
+using engine::LimitingState;
+using engine::RunStats;
+
+std::string signals_csv(const engine::RunResult& r) {
+  std::ostringstream out;
+  out.precision(12);
+  const int nsig = r.num_signals();
+  const int ns = static_cast<int>(r.sensitivity_names.size());
+  out << "t";
+  for (const auto& s : r.signal_names) out << ',' << s;
+  for (const auto& p : r.sensitivity_names)
+    for (const auto& s : r.signal_names) out << ",d(" << s << ")/d(" << p << ')';
+  out << '\n';
+  for (size_t k = 0; k < r.t.size(); ++k) {
+    out << r.t[k];
+    for (int i = 0; i < nsig; ++i) out << ',' << r.value(static_cast<int>(k), i);
+    for (int d = 0; d < ns; ++d)
+      for (int i = 0; i < nsig; ++i) out << ',' << r.tangent(static_cast<int>(k), d, i);
+    out << '\n';
+  }
+  return out.str();
+}
+
+std::string objectives_json(const engine::RunResult& r) {
+  nlohmann::ordered_json objectives = nlohmann::ordered_json::object();
+  for (const auto& o : r.objectives) {
+    nlohmann::ordered_json sens = nlohmann::ordered_json::object();
+    for (size_t d = 0; d < r.sensitivity_names.size(); ++d) sens[r.sensitivity_names[d]] = o.sensitivity[d];
+    objectives[o.name] = {{"value", o.value}, {"unit", o.unit}, {"sensitivity", sens}};
+  }
+  return nlohmann::ordered_json{{"objectives", objectives}}.dump(2) + "\n";
+}
+
+std::string run_json(const engine::Diagram& d, const engine::RunResult& r) {
+  const RunStats& s = r.stats;
+  nlohmann::ordered_json parameters = nlohmann::ordered_json::object();
+  for (const auto& p : d.parameters) parameters[p.name] = {{"value", p.value}, {"unit", p.unit}};
+  // Per state: the share of the accepted steps at which it had the largest weighted local error.
+  nlohmann::ordered_json limiting = nlohmann::ordered_json::array();
+  for (const LimitingState& l : s.limiting_states)
+    limiting.push_back({{"state", l.state}, {"steps", l.steps}, {"share", l.share}});
+  nlohmann::ordered_json j = {
+      {"scene", d.scene_name},
+      {"file", d.file},
+      {"solver", s.method},
+      {"rtol", s.rtol},
+      {"atol", s.atol},
+      {"fixed_step", s.step},
+      {"sens_error_test", d.solver.sens_error_test},
+      {"nominal_scaling", d.solver.nominal_scaling},
+      {"newton_coefficient", d.solver.newton_coefficient},
+      {"refresh_local_jacobians", d.solver.refresh_local_jacobians},
+      {"max_order", s.max_order},
+      {"parameters", parameters},
+      {"sensitivities", r.sensitivity_names},
+      {"states", d.num_states},
+      {"steps", s.steps},
+      {"rhs_evaluations", s.rhs_evals},
+      {"sensitivity_rhs_evaluations", s.sens_rhs_evals},
+      {"jacobian_evaluations", s.jac_evals},
+      {"jacobian_colours", s.jacobian_colours},
+      {"local_jacobian_refreshes", s.local_jac_evals},
+      {"substeps", s.substeps},
+      {"error_test_failures", s.error_test_failures},
+      {"nonlinear_iterations", s.nonlinear_iterations},
+      {"nonlinear_failures", s.nonlinear_failures},
+      {"steps_per_order", s.steps_per_order},
+      {"limiting_states", limiting},
+      {"cpu_seconds", s.cpu_seconds},
+      {"simulated_seconds", s.simulated_seconds},
+      {"realtime_factor", s.realtime_factor},
+      {"pruned_blocks", d.pruned},
+      {"warnings", s.warnings},
+  };
+  return j.dump(2) + "\n";
+}
+
+void write_outputs(const std::string& dir, const engine::Diagram& d, const engine::RunResult& r) {
+  std::filesystem::create_directories(dir);
+  // Compose everything first so that a failure leaves no half-written set behind.
+  const std::string signals = signals_csv(r), objectives = objectives_json(r), run = run_json(d, r);
+  write_file_atomically(dir + "/signals.csv", signals);
+  write_file_atomically(dir + "/objectives.json", objectives);
+  write_file_atomically(dir + "/run.json", run);
+}
+
+}  // namespace dydp::io

@@ -1,0 +1,16 @@
+// Recorded signals as a table of named columns, from a CSV file or an MTS RPC III
+// time-history file (.rsp, .drv, .tim): the RPC III channels are named by their descriptions
+// (DESC.CHAN_n), after a column `t` of the sample times k * DELTA_T.
+#pragma once
+
+#include <string>
+
+#include "io/csv.hpp"
+
+namespace dydp::io {
+
+/// Reads a recording by its extension (RPC III for .rsp, .drv, .tim; CSV otherwise). Throws
+/// InputError as read_csv and read_rpc3 do.
+CsvFile read_recording(const std::string& path);
+
+}  // namespace dydp::io
