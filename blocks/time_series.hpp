@@ -1,5 +1,5 @@
 // Recorded signals against time for source blocks (tables, steering records, shaker pads):
-// read from a recording (CSV or RPC III, engine/recording.hpp) named in the block's settings,
+// read from a recording (CSV or RPC III, io/recording.hpp) named in the block's settings,
 // interpolated linearly or by a cubic spline (value, slope and curvature continuous: a recorded
 // displacement, its rate and its acceleration).
 #pragma once

@@ -1,7 +1,7 @@
 // CVODES (BDF or Adams) with forward sensitivities by the direct method: the sensitivity
 // right-hand side is the diagram's tangent pass, corrected simultaneously with the states and
 // included in the error test or not (solver.sens_error_test); absolute tolerances per state
-// from the blocks' nominal magnitudes (engine/tolerances.hpp); the Newton matrix is the exact
+// from the blocks' nominal magnitudes (engine/analysis/tolerances.hpp); the Newton matrix is the exact
 // Jacobian from tangent passes over the states. Objective integrals are integrated with the
 // states: CVODES' vector is [x; q], their integrands evaluated by the same value and tangent
 // passes as xdot (CVODES' own quadratures would cost one more value pass and one more tangent

@@ -1,5 +1,5 @@
 // The Newton iteration's linear solver for CVODES: the dense matrix SUNDIALS forms (I - gamma J)
-// factored by NewtonLU (engine/newton_lu.hpp: the rows x_i + c x_j = b_i substituted out, the
+// factored by NewtonLU (engine/analysis/newton_lu.hpp: the rows x_i + c x_j = b_i substituted out, the
 // rest by Eigen's partial-pivoting LU) instead of SUNDIALS' own column-by-column GETRF/GETRS,
 // which on the sedan's 52 states took about a seventh of the main job. A SUNDIALS linear solver
 // of the direct type on a dense SUNMatrix, so CVODES uses it like SUNLinSol_Dense; a zero pivot

@@ -24,7 +24,7 @@ struct RunOptions {
   std::function<void(const RunResult&)> on_sample;
 };
 
-/// A state that limited the step size (see engine/step_limiters.hpp).
+/// A state that limited the step size (see engine/analysis/step_limiters.hpp).
 struct LimitingState {
   std::string state;   ///< block.state
   long steps = 0;      ///< accepted steps at which its weighted local error was the largest
@@ -39,7 +39,7 @@ struct RunStats {
   long sens_rhs_evals = 0;        ///< tangent passes for the sensitivity equations
   long jac_evals = 0;             ///< Jacobians (each one tangent pass over jacobian_colours directions)
   /// Directions of a Jacobian's tangent pass: the colours of its columns (columns whose rows do
-  /// not meet share one, engine/jacobian_colouring.hpp), the states when none can share.
+  /// not meet share one, engine/evaluation/jacobian_colouring.hpp), the states when none can share.
   int jacobian_colours = 0;
   long local_jac_evals = 0;       ///< refreshes of the blocks' own diagonal Jacobian blocks only
   long error_test_failures = 0;

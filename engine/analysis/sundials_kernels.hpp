@@ -10,7 +10,7 @@
 //
 // Each kernel does per element what the library's does, in the same order, including its special
 // cases (N_VLinearSum's a == b and a == -b forms, N_VLinearCombination's two- and one-vector
-// forms): the results are the same bit for bit (tests/engine/sundials_kernels_test.cpp).
+// forms): the results are the same bit for bit (tests/engine/analysis/sundials_kernels_test.cpp).
 #pragma once
 
 #include <sundials/sundials_matrix.h>

@@ -38,7 +38,7 @@ struct BlockType {
   std::vector<SettingSpec> settings;
   std::function<std::unique_ptr<Block>(const BlockSettings&)> make;
   /// Relations its values must satisfy, checked at load time and whenever a scene parameter
-  /// driving one of them changes (engine/consistency_checks.hpp).
+  /// driving one of them changes (engine/scene/consistency_checks.hpp).
   std::vector<BlockCheck> checks = {};
 };
 

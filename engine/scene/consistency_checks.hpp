@@ -1,4 +1,4 @@
-// Running a block type's consistency checks (engine/block_check.hpp) over one node of a
+// Running a block type's consistency checks (engine/framework/block_check.hpp) over one node of a
 // diagram: a broken error rule is an InputError at the line of the field it names; a broken
 // warning rule becomes a "file:line: field: message" warning of the run.
 #pragma once

@@ -1,5 +1,5 @@
 // A block's `nominal:` map in a scene: the nominal magnitudes of some of its states, by state
-// name, replacing those its type declares (see engine/tolerances.hpp for what they scale).
+// name, replacing those its type declares (see engine/analysis/tolerances.hpp for what they scale).
 #pragma once
 
 #include <string>

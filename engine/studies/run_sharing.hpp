@@ -33,7 +33,7 @@ bool built_with_mpi();
 void share_runs(const std::vector<int>& todo, const std::function<std::string(int)>& run_one,
                 const std::function<void(int, const std::string&)>& record, int threads = 0);
 
-/// Implementation of share_runs among the ranks (engine/run_sharing_mpi.cpp).
+/// Implementation of share_runs among the ranks (engine/studies/run_sharing_mpi.cpp).
 void share_runs_over_ranks(const std::vector<int>& todo, const std::function<std::string(int)>& run_one,
                            const std::function<void(int, const std::string&)>& record, int threads);
 

@@ -2,7 +2,7 @@
 // one run with all P sensitivity directions, plus one run at the nominal point; the runs shared
 // among threads and MPI ranks, each recorded in the output folder as it ends (runs/run_NNNNN.json,
 // written atomically) so that an interrupted study resumes where it stopped; then the screening
-// measures of every objective (engine/screening.hpp).
+// measures of every objective (engine/studies/screening.hpp).
 #pragma once
 
 #include <functional>

@@ -1,5 +1,5 @@
 // Parameter sweeps: psi and d(psi)/dp at each point of a range of one scene parameter, runs
-// spread over the machine's cores (and over MPI ranks under mpirun, engine/run_sharing.hpp); optionally central finite differences at given steps, to
+// spread over the machine's cores (and over MPI ranks under mpirun, engine/studies/run_sharing.hpp); optionally central finite differences at given steps, to
 // show their error against the exact derivative.
 #pragma once
 

@@ -1,4 +1,4 @@
-// The Jacobian from the diagram's structure (engine/jacobian_colouring.hpp): columns whose
+// The Jacobian from the diagram's structure (engine/evaluation/jacobian_colouring.hpp): columns whose
 // rows do not meet share a tangent pass, and the Jacobian scattered back from the colours is
 // the one-column-per-direction Jacobian entry for entry; every nonzero of it lies in the
 // structure.

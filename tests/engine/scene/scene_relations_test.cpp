@@ -1,5 +1,5 @@
 // Scene validation beyond single values (issue 17): keys given twice, relations between the
-// fields of the time and solver sections, each block's consistency rules (engine/block_check.hpp)
+// fields of the time and solver sections, each block's consistency rules (engine/framework/block_check.hpp)
 // and the warnings for legal but probably unintended input. Every refusal is an InputError
 // naming file, line and field; loading writes nothing, so a refused scene leaves nothing behind.
 //
