@@ -49,6 +49,14 @@ std::string run_json(const engine::Diagram& d, const engine::RunResult& r) {
   nlohmann::ordered_json limiting = nlohmann::ordered_json::array();
   for (const LimitingState& l : s.limiting_states)
     limiting.push_back({{"state", l.state}, {"steps", l.steps}, {"share", l.share}});
+  nlohmann::ordered_json estimate = nullptr;
+  if (s.error_estimate.estimated)
+    estimate = {{"signals", s.error_estimate.signal_error},
+                {"sensitivities", s.error_estimate.sensitivity_error},
+                {"worst_signal", s.error_estimate.worst_signal},
+                {"worst_sensitivity", s.error_estimate.worst_sensitivity},
+                {"how", s.error_estimate.how},
+                {"cpu_seconds", s.error_estimate.cpu_seconds}};
   nlohmann::ordered_json j = {
       {"scene", d.scene_name},
       {"file", d.file},
@@ -79,6 +87,7 @@ std::string run_json(const engine::Diagram& d, const engine::RunResult& r) {
       {"cpu_seconds", s.cpu_seconds},
       {"simulated_seconds", s.simulated_seconds},
       {"realtime_factor", s.realtime_factor},
+      {"error_estimate", estimate},
       {"pruned_blocks", d.pruned},
       {"warnings", s.warnings},
   };

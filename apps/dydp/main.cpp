@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
   run->add_option("--out", run_args.out, "output folder")->capture_default_str();
   run->add_option("--set", run_args.sets, "override a scene parameter: NAME=VALUE");
   run->add_flag("--no-sens", run_args.no_sens, "run without sensitivities");
+  run->add_flag("--no-estimate", run_args.no_estimate, "no shadow run: no estimate of the run's error");
   run->add_flag("--report", run_args.report, "also write plots (gnuplot) and report.md");
   add_solver_options(run, run_args.solver);
   run->add_option("--format", run_args.format, "csv: the CSV/JSON files; mat: also run.mat (MAT v5)")
@@ -80,6 +81,7 @@ int main(int argc, char** argv) {
   replay->add_option("--set", replay_args.sets, "override a scene parameter: NAME=VALUE");
   replay->add_flag("--realtime", replay_args.realtime, "pace the run to the wall clock and report missed deadlines");
   replay->add_flag("--no-sens", replay_args.no_sens, "run without sensitivities");
+  replay->add_flag("--no-estimate", replay_args.no_estimate, "no shadow run: no estimate of the replay's error");
   add_solver_options(replay, replay_args.solver);
   replay->add_option("--format", replay_args.format,
                      "csv: the CSV/JSON files; mat: also replay.mat (MAT v5); rpc: also signals.rsp (RPC III)")

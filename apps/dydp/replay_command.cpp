@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "apps/dydp/commands.hpp"
+#include "engine/analysis/error_estimate.hpp"
 #include "engine/analysis/run.hpp"
 #include "engine/framework/errors.hpp"
 #include "io/files.hpp"
@@ -23,10 +24,12 @@
 namespace dydp::apps {
 namespace {
 
-/// Replay's step with Rosenbrock-W when neither --step nor a rosw scene gives one: on the
-/// sedan's 60 s shaker file it keeps the signals within 0.7 % and the valve-current sensitivity
-/// within 2.1 % of a converged BDF run, at about 90x real time (docs/accuracy.md, 2026-12-06).
-constexpr double kReplayStep = 0.0025;
+/// Replay's tolerances with Rosenbrock-W when neither --step nor a rosw scene fixes its step
+/// (and --rtol, --atol do not give them): the error-controlled steps' rtol and atol (atol
+/// relative to each state's nominal magnitude), chosen for replay's stated accuracy, 1 % in
+/// every logged signal and 5 % in every sensitivity column (docs/accuracy.md).
+constexpr double kReplayRtol = 2e-3;
+constexpr double kReplayAtol = 2e-3;
 
 double interpolate(const std::vector<double>& t, const std::vector<double>& y, double x) {
   if (x <= t.front()) return y.front();
@@ -84,7 +87,8 @@ int replay_command(const ReplayArgs& args) {
   engine::Diagram d = engine::load_scene(args.scene, parse_sets(args.sets), {{"input_file", input}});
   // Replay integrates with Rosenbrock-W (rosw) unless --solver names another integrator: its
   // local stages follow the dampers' valves at millisecond steps (docs/engine.md).
-  // With rosw, named or not, the step is --step, else the scene's own rosw step, else 2.5 ms.
+  // With rosw, named or not, the step is --step, else the scene's own rosw step, else chosen by
+  // the error control at replay's tolerances (--rtol, --atol change them).
   engine::SolverOverrides solver = args.solver;
   if (solver.method.empty()) {
     if (solver.max_order)
@@ -94,8 +98,15 @@ int replay_command(const ReplayArgs& args) {
     solver.method = "rosw";
   }
   const bool scene_rosw_step = d.solver.method == "rosw" && d.solver.step > 0;
-  if (solver.method == "rosw" && !solver.step && !scene_rosw_step) solver.step = kReplayStep;
+  if (solver.method == "rosw" && !solver.step && !scene_rosw_step) {
+    if (!solver.rtol) solver.rtol = kReplayRtol;
+    if (!solver.atol) solver.atol = kReplayAtol;
+  }
   engine::apply_solver_overrides(d, solver);
+  // Replay's error-controlled rosw holds the sensitivities to the tolerances as well: on rough
+  // roads their error at a valve's switch is not the states' (docs/accuracy.md).
+  const bool controlled_rosw = d.solver.method == "rosw" && d.solver.step <= 0;
+  if (controlled_rosw) d.solver.sens_error_test = true;
   bool takes_input = false;
   for (const auto& n : d.nodes)
     for (const auto& s : n.type->settings) takes_input = takes_input || s.name == "input_file";
@@ -124,7 +135,15 @@ int replay_command(const ReplayArgs& args) {
     worst_lag = std::max(worst_lag, now - due);
   };
   const auto t0 = std::chrono::steady_clock::now();
-  const engine::RunResult r = engine::run(d, options);
+  engine::RunResult r;
+  if (args.no_estimate) {
+    r = engine::run(d, options);
+  } else {
+    engine::Diagram shadow = engine::load_scene(args.scene, parse_sets(args.sets), {{"input_file", input}});
+    engine::apply_solver_overrides(shadow, solver);
+    shadow.solver.sens_error_test = d.solver.sens_error_test;
+    r = engine::run_with_error_estimate(d, shadow, options);
+  }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   stream.finish();
   io::write_file_atomically(args.out + "/objectives.json", io::objectives_json(r));
@@ -142,6 +161,8 @@ int replay_command(const ReplayArgs& args) {
   if (args.realtime) std::cout << ", paced: " << missed << " missed deadlines";
   std::cout << "\n";
   print_limiting_states(std::cout, r.stats);
+  print_error_estimate(std::cout, r.stats);
+  print_run_warnings(d, r);
   j["validation"] = nlohmann::ordered_json::object();
   for (size_t c = 1; c < recorded.names.size(); ++c) {
     const int i = r.signal_index(recorded.names[c]);

@@ -1,5 +1,6 @@
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iomanip>
@@ -7,6 +8,7 @@
 
 #include "apps/dydp/commands.hpp"
 #include "apps/dydp/report.hpp"
+#include "engine/analysis/error_estimate.hpp"
 #include "engine/analysis/run.hpp"
 #include "engine/framework/errors.hpp"
 #include "io/mat_outputs.hpp"
@@ -36,6 +38,19 @@ void print_limiting_states(std::ostream& out, const engine::RunStats& stats) {
   out << std::defaultfloat << "\n";
 }
 
+void print_error_estimate(std::ostream& out, const engine::RunStats& stats) {
+  const engine::ErrorEstimate& e = stats.error_estimate;
+  if (!e.estimated) return;
+  out << "  estimated error: signals " << std::setprecision(2) << 100 * e.signal_error << " %";
+  if (!e.worst_sensitivity.empty()) out << ", sensitivities " << 100 * e.sensitivity_error << " %";
+  out << " (" << e.how << ", " << std::setprecision(3) << e.cpu_seconds << " CPU s in a second thread)\n";
+}
+
+void print_run_warnings(const engine::Diagram& d, const engine::RunResult& r) {
+  for (const std::string& w : r.stats.warnings)
+    if (std::find(d.warnings.begin(), d.warnings.end(), w) == d.warnings.end()) std::cerr << "warning: " << w << "\n";
+}
+
 void print_warnings(const std::vector<std::string>& warnings) {
   for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
 }
@@ -56,7 +71,14 @@ int run_command(const RunArgs& args) {
     std::cerr << "\r" << d.scene_name << ": t = " << std::fixed << std::setprecision(2) << t
               << " s  [" << percent << "%]" << std::flush;
   };
-  const engine::RunResult r = engine::run(d, options);
+  engine::RunResult r;
+  if (args.no_estimate) {
+    r = engine::run(d, options);
+  } else {
+    engine::Diagram shadow = engine::load_scene(args.scene, parse_sets(args.sets));
+    engine::apply_solver_overrides(shadow, args.solver);
+    r = engine::run_with_error_estimate(d, shadow, options);
+  }
   if (tty) std::cerr << "\r" << std::string(60, ' ') << "\r";
 
   io::write_outputs(args.out, d, r);
@@ -68,6 +90,8 @@ int run_command(const RunArgs& args) {
             << r.stats.simulated_seconds << " s simulated (" << std::setprecision(4)
             << r.stats.realtime_factor << "x real time)\n";
   print_limiting_states(std::cout, r.stats);
+  print_error_estimate(std::cout, r.stats);
+  print_run_warnings(d, r);
   for (const auto& o : r.objectives) {
     std::cout << "  " << o.name << " = " << std::setprecision(6) << o.value << (o.unit.empty() ? "" : " " + o.unit);
     for (size_t k = 0; k < o.sensitivity.size(); ++k) {

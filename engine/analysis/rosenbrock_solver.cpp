@@ -59,6 +59,18 @@ class Ros2Stepper final : public Stepper {
     stats_.jacobian_colours = colouring_.colours();
     const std::vector<double> nominal = state_nominals(d);
     scale_ = Eigen::Map<const Vector>(nominal.data(), nx_);
+    adaptive_ = !fixed_ && d.solver.step <= 0;
+    if (adaptive_) {
+      rtol_ = d.solver.rtol;
+      const AbsoluteTolerances atol = absolute_tolerances(d, d.solver.atol, ns_);
+      atol_ = Eigen::Map<const Vector>(atol.states.data(), nx_);
+      sens_in_test_ = d.solver.sens_error_test && ns_ > 0;
+      if (sens_in_test_) atol_s_ = Eigen::Map<const Matrix>(atol.sensitivities.data(), nx_, ns_);
+      h_pref_ = d.time.output_step / 10.0;
+      h_floor_ = 1e-12 * std::max(1.0, std::fabs(d.time.stop - d.time.start));
+      stats_.rtol = d.solver.rtol;
+      stats_.atol = d.solver.atol;
+    }
     if (fixed_) w_ = Eigen::Map<const Matrix>(fixed_w->data(), nx_, nx_);
     const int nx1 = std::max(nx_, 1), nq1 = std::max(nq_, 1);
     for (Vector* v : {&f_start_, &f_end_, &f_stage_, &k1_, &k2_, &y_stage_, &x_end_}) v->setZero(nx1);
@@ -82,6 +94,7 @@ class Ros2Stepper final : public Stepper {
 
   void advance(MarchState& s, double target) override {
     const Held held(*this, s);
+    if (adaptive_) return advance_controlled(target);
     const double t_start = s.t;
     const long n = fixed_steps(t_start, target, h_max_);
     const double h = (target - t_start) / n;
@@ -91,7 +104,7 @@ class Ros2Stepper final : public Stepper {
     }
   }
 
-  double reported_step() const override { return h_max_; }
+  double reported_step() const override { return adaptive_ ? 0.0 : h_max_; }
 
   /// Leaves the evaluator's signals and tangents at (t, x) for the recorder.
   void prepare_record(const MarchState& s, Evaluator&, int) override {
@@ -207,6 +220,21 @@ class Ros2Stepper final : public Stepper {
     if (nx_ == 0) return 0.0;
     const Vector weight = scale_.cwiseMax(x_end_.head(nx_).cwiseAbs());
     const Vector error = (0.5 * h * (k1_.head(nx_) + k2_.head(nx_))).cwiseQuotient(weight);
+    if (adaptive_) {
+      // The error test's norm: the same difference over atol_i + rtol |x_i| (at both ends).
+      const Vector tolerance =
+          atol_ + rtol_ * x.head(nx_).cwiseAbs().cwiseMax(x_end_.head(nx_).cwiseAbs());
+      double sum = (0.5 * h * (k1_.head(nx_) + k2_.head(nx_))).cwiseQuotient(tolerance).squaredNorm();
+      int count = nx_;
+      if (sens_in_test_) {
+        // The sensitivities' own embedded estimate h/2 (dk1 + dk2), within atol_i / |p_j| +
+        // rtol |S_ij| (CVODES' weights for them).
+        const Matrix tol_s = atol_s_ + rtol_ * S.cwiseAbs().cwiseMax(s_end_.cwiseAbs());
+        sum += (0.5 * h * (dk1_ + dk2_)).cwiseQuotient(tol_s).squaredNorm();
+        count += nx_ * ns_;
+      }
+      error_norm_ = std::sqrt(sum / count);
+    }
     return std::sqrt(error.squaredNorm() / nx_);
   }
 
@@ -229,6 +257,47 @@ class Ros2Stepper final : public Stepper {
     ++stats_.steps;
     if (fixed_) return;
     if (++age_ >= (local_stages_ ? kRefreshStepsLocal : kRefreshSteps)) refresh(t, x);
+  }
+
+  /// Error-controlled steps from t to target: each step's embedded estimate (the difference
+  /// of the order-2 solution and the order-1 solution xn + h k1) must be within atol_i + rtol
+  /// |x_i| in the rms norm over the states, or the step is taken again smaller. The next step
+  /// comes from Gustafsson's PI controller on that estimate (of order h^2: exponents 0.7 / 2
+  /// and 0.4 / 2), and the steps to the next stop are made equal (n steps of (target - t) / n,
+  /// at most the controller's), so that an output grid finer than the steps does not cut them
+  /// and the Newton matrix is kept over the steps of equal size.
+  void advance_controlled(double target) {
+    while (t < target) {
+      const double remaining = target - t;
+      const double n = std::max(1.0, std::ceil(remaining / h_pref_ - 1e-9));
+      const double h = n == 1.0 ? remaining : remaining / n;
+      if (h < h_floor_)
+        throw SolverError(t, "", "error-controlled step " + format_number(h) +
+                                     " s too small: the solution changes faster than rosw can follow here; use "
+                                     "method bdf");
+      try {
+        const double estimate = attempt(h);
+        if (age_ > 0 && estimate > kDivergenceFloor && estimate > kDivergenceGrowth * last_estimate_) {
+          refresh(t, x);  // a stale W on a stiff component: the step again with W at its start
+          continue;
+        }
+        const double err = error_norm_;
+        if (!(err <= 1.0)) {
+          ++stats_.error_test_failures;
+          h_pref_ = h * (std::isfinite(err) ? std::clamp(0.9 / std::sqrt(err), 0.2, 0.9) : 0.25);
+          continue;
+        }
+        accept(h, estimate);
+        const double e = std::max(err, 1e-8);
+        const double grow = 0.9 * std::pow(e, -0.35) * std::pow(last_error_norm_, 0.2);
+        h_pref_ = h * std::clamp(grow, 0.2, 2.0);
+        last_error_norm_ = e;
+      } catch (const StageFailure& failure) {
+        if (age_ > 0 && refreshed(t, x)) continue;  // a stale W first
+        ++stats_.nonlinear_failures;
+        h_pref_ = h / 4;
+      }
+    }
   }
 
   /// Whether some block gives a local Jacobian: then its rows of each stage are solved exactly
@@ -334,6 +403,15 @@ class Ros2Stepper final : public Stepper {
   Vector zero_, cv_;                 ///< the stages' c: 0 and -2 k1
   Matrix dzero_, dcv_;               ///< and their tangents
   Vector scale_;
+  bool adaptive_ = false;         ///< error-controlled steps (no fixed step given)
+  double rtol_ = 0.0;
+  Vector atol_;                   ///< per state: atol times its nominal magnitude
+  bool sens_in_test_ = false;     ///< the sensitivities in the error test (solver.sens_error_test)
+  Matrix atol_s_;                 ///< their absolute tolerances (nx x ns)
+  double h_pref_ = 0.0;           ///< the controller's next step
+  double h_floor_ = 0.0;          ///< below this the run stops
+  double error_norm_ = 0.0;       ///< the last attempt's error in the tolerances' norm
+  double last_error_norm_ = 1.0;  ///< the last accepted step's (the PI controller's memory)
   Vector f_start_, f_end_, f_stage_, k1_, k2_, y_stage_, x_end_, g_start_, g_end_, g_stage_, q_end_;
   Matrix df_start_, df_end_, df_stage_, dk1_, dk2_, dy_stage_, s_end_, dg_start_, dg_end_, dg_stage_, sq_end_;
 };

@@ -31,6 +31,19 @@ struct LimitingState {
   double share = 0.0;  ///< steps / all counted steps
 };
 
+/// The run's own estimate of its global error (engine/analysis/error_estimate.hpp): the worst
+/// over the output grid of |error| over each column's largest magnitude, over the logged
+/// signals and, apart, over their sensitivity columns.
+struct ErrorEstimate {
+  bool estimated = false;
+  double signal_error = 0.0;       ///< over the logged signals (Qt's macro takes "signals")
+  double sensitivity_error = 0.0;  ///< over their sensitivity columns
+  std::string how;           ///< what it was estimated from ("shadow at 4 x rtol, atol")
+  double cpu_seconds = 0.0;  ///< the shadow run's CPU time (its own thread), not in cpu_seconds
+  std::string worst_signal;       ///< the column of the largest signal error
+  std::string worst_sensitivity;  ///< the column of the largest sensitivity error
+};
+
 struct RunStats {
   std::string method;
   double rtol = 0.0, atol = 0.0, step = 0.0;
@@ -57,6 +70,7 @@ struct RunStats {
   std::vector<long> steps_per_order;
   /// Variable-step solvers: the states that limited the step most often, most often first.
   std::vector<LimitingState> limiting_states;
+  ErrorEstimate error_estimate;
 };
 
 struct ObjectiveResult {

@@ -7,6 +7,8 @@
 #include <mutex>
 #include <thread>
 
+#include "engine/studies/run_filing.hpp"
+
 namespace dydp::engine {
 
 #ifndef DYDP_HAVE_MPI
@@ -29,7 +31,7 @@ void share_runs(const std::vector<int>& todo, const std::function<std::string(in
   // Workers take the next run and queue its record; the calling thread records in turn.
   std::mutex mutex;
   std::condition_variable ready;
-  std::deque<std::pair<int, std::string>> done;
+  FiledRuns done;
   int next = 0, running = workers;
   std::exception_ptr failure;
   auto worker = [&] {
@@ -40,14 +42,7 @@ void share_runs(const std::vector<int>& todo, const std::function<std::string(in
         if (failure || next >= n) break;
         k = todo[next++];
       }
-      try {
-        std::string result = run_one(k);
-        std::lock_guard<std::mutex> lock(mutex);
-        done.emplace_back(k, std::move(result));
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!failure) failure = std::current_exception();
-      }
+      run_and_file(k, run_one, mutex, done, failure);
       ready.notify_one();
     }
     std::lock_guard<std::mutex> lock(mutex);

@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "engine/framework/errors.hpp"
+#include "engine/studies/run_filing.hpp"
 #include "engine/studies/run_sharing.hpp"
 
 namespace dydp::engine {
@@ -127,7 +128,7 @@ void share_runs_over_ranks(const std::vector<int>& todo, const std::function<std
   if (world_rank() != 0) return serve(run_one);
 
   std::mutex mutex;
-  std::deque<std::pair<int, std::string>> done;  // local threads' records, in the order they end
+  FiledRuns done;  // local threads' records, in the order they end
   size_t next = 0;
   std::exception_ptr failure;
   auto take = [&]() -> int {  // under mutex
@@ -142,14 +143,7 @@ void share_runs_over_ranks(const std::vector<int>& todo, const std::function<std
         k = take();
       }
       if (k < 0) return;
-      try {
-        std::string result = run_one(k);
-        std::lock_guard<std::mutex> lock(mutex);
-        done.emplace_back(k, std::move(result));
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!failure) failure = std::current_exception();
-      }
+      run_and_file(k, run_one, mutex, done, failure);
     }
   };
   std::vector<std::thread> pool;
