@@ -14,7 +14,7 @@
 namespace dydp::engine {
 namespace {
 
-const double kGamma = kGamma2;
+constexpr double kGamma = kGamma2;
 /// Newton corrections that shrink by less than this factor from one iteration to the next call
 /// for a refresh of the iteration matrix (on the sedan replay 0.1 cost least; 0.25, 0.05 and
 /// 0.02 cost 16 %, 7 % and 34 % more).

@@ -22,7 +22,10 @@ using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic>;
 using Vector = Eigen::VectorXd;
 
 /// gamma = 1 - 1/sqrt 2: SDIRK2's (L-stable, stiffly accurate) and ROS2's (rosenbrock_solver.cpp).
-inline const double kGamma2 = 1.0 - 1.0 / std::sqrt(2.0);
+/// A literal (the double nearest to what 1.0 - 1.0 / std::sqrt(2.0) rounds to), so that it is
+/// constant-initialised: computed, it would be initialised at start-up in an order the other
+/// files' constants cannot rely on (clang does not fold std::sqrt). step_driver_test checks it.
+inline constexpr double kGamma2 = 0.29289321881345254;
 
 /// What a stepper advances: x (num_states), q (max(num_quadratures, 1): one unused zero
 /// without quadratures), S = dx/dp (num_states x ns), Sq = dq/dp (q's rows x ns).

@@ -4,7 +4,8 @@
 //   error falls as delta^2 until rounding), for the signals on the grid and the objective;
 // - runs that evaluate W themselves (W = J(p), so W moves with p) differ from that derivative by
 //   the neglected dW/dp term, which is of the order of the discretisation error: it falls as h^2;
-// - states, sensitivities and the objective converge at order 2 to the closed form.
+// - states, sensitivities and the objective converge at order 2 to the closed form;
+// - its gamma, a literal, is 1 - 1/sqrt 2.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,6 +13,7 @@
 
 #include "engine/analysis/rosenbrock_solver.hpp"
 #include "engine/analysis/run.hpp"
+#include "engine/analysis/step_driver.hpp"
 #include "engine/analysis/timeline.hpp"
 #include "engine/evaluation/evaluator.hpp"
 #include "engine/framework/diagram.hpp"
@@ -25,6 +27,13 @@ using test::grid_error;
 
 const std::string kScene = std::string(DYDP_SOURCE_DIR) + "/scenarios/msd_sensitivity.yaml";
 constexpr double kWindowFrom = 2.0, kWindowTo = 10.0;
+
+// ROS2's and SDIRK2's gamma is a literal so that it is initialised before any other file's
+// constants read it: it must be the double that 1 - 1/sqrt 2 rounds to.
+TEST(Rosenbrock, GammaIsOneMinusOneOverRootTwo) {
+  const double root_two = std::sqrt(2.0);
+  EXPECT_EQ(kGamma2, 1.0 - 1.0 / root_two);
+}
 
 Diagram load(double step) {
   Diagram d = load_scene(kScene);
