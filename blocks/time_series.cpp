@@ -1,9 +1,11 @@
 #include "blocks/time_series.hpp"
 
 #include <algorithm>
+#include <memory>
 #include <sstream>
 
 #include "engine/framework/errors.hpp"
+#include "engine/framework/interpolation.hpp"
 #include "io/recording.hpp"
 
 namespace dydp::blocks {
@@ -13,13 +15,7 @@ size_t TimeSeries::segment(double t) const {
   return std::min(std::max<size_t>(k, 1), t_.size() - 1);  // segment [k - 1, k]
 }
 
-double TimeSeries::linear(double t) const {
-  if (t <= t_.front()) return y_.front();
-  if (t >= t_.back()) return y_.back();
-  const size_t k = segment(t);
-  const double w = (t - t_[k - 1]) / (t_[k] - t_[k - 1]);
-  return (1 - w) * y_[k - 1] + w * y_[k];
-}
+double TimeSeries::linear(double t) const { return engine::interpolate_linear(t_, y_, t); }
 
 TimeSeries::TimeSeries(std::vector<double> t, std::vector<double> y)
     : t_(std::move(t)), y_(std::move(y)), slope_(t_.size(), 0.0) {
@@ -97,13 +93,14 @@ std::vector<TimeSeries> read_time_series(const engine::BlockSettings& s, const s
                                          const std::vector<std::string>& columns,
                                          const std::string& columns_key) {
   const std::string file = s.path(file_key);
-  io::CsvFile csv;
+  std::shared_ptr<const io::CsvFile> recording;
   try {
-    csv = io::read_recording(file);
+    recording = io::load_recording(file);
   } catch (const engine::InputError& e) {
     if (e.line() == 0 && e.field().empty()) s.fail(file_key, "cannot open '" + file + "'");
     throw;
   }
+  const io::CsvFile& csv = *recording;
   const int ct = csv.find(time_column);
   if (ct < 0) s.fail(columns_key == file_key ? file_key : "time_column", "no column '" + time_column + "' in " + file);
   const std::vector<double>& t = csv.columns[ct];

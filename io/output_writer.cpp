@@ -1,5 +1,6 @@
 #include "io/output_writer.hpp"
 
+#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -11,24 +12,57 @@ namespace dydp::io {
 using engine::LimitingState;
 using engine::RunStats;
 
-std::string signals_csv(const engine::RunResult& r) {
-  std::ostringstream out;
-  out.precision(12);
-  const int nsig = r.num_signals();
-  const int ns = static_cast<int>(r.sensitivity_names.size());
+namespace {
+
+void write_signals_header(std::ostream& out, const engine::RunResult& r) {
   out << "t";
   for (const auto& s : r.signal_names) out << ',' << s;
   for (const auto& p : r.sensitivity_names)
     for (const auto& s : r.signal_names) out << ",d(" << s << ")/d(" << p << ')';
   out << '\n';
-  for (size_t k = 0; k < r.t.size(); ++k) {
-    out << r.t[k];
-    for (int i = 0; i < nsig; ++i) out << ',' << r.value(static_cast<int>(k), i);
-    for (int d = 0; d < ns; ++d)
-      for (int i = 0; i < nsig; ++i) out << ',' << r.tangent(static_cast<int>(k), d, i);
-    out << '\n';
-  }
+}
+
+void write_signals_row(std::ostream& out, const engine::RunResult& r, size_t k) {
+  const int nsig = r.num_signals();
+  const int ns = static_cast<int>(r.sensitivity_names.size());
+  out << r.t[k];
+  for (int i = 0; i < nsig; ++i) out << ',' << r.value(static_cast<int>(k), i);
+  for (int d = 0; d < ns; ++d)
+    for (int i = 0; i < nsig; ++i) out << ',' << r.tangent(static_cast<int>(k), d, i);
+  out << '\n';
+}
+
+}  // namespace
+
+std::string signals_csv(const engine::RunResult& r) {
+  std::ostringstream out;
+  out.precision(12);
+  write_signals_header(out, r);
+  for (size_t k = 0; k < r.t.size(); ++k) write_signals_row(out, r, k);
   return out.str();
+}
+
+SignalsCsvStream::SignalsCsvStream(std::string path) : path_(std::move(path)), partial_(path_ + ".partial") {}
+
+SignalsCsvStream::~SignalsCsvStream() {
+  if (!done_) std::remove(partial_.c_str());
+}
+
+void SignalsCsvStream::sample(const engine::RunResult& r) {
+  if (!out_.is_open()) {
+    out_.open(partial_, std::ios::trunc);
+    if (!out_) throw std::runtime_error("cannot write " + partial_);
+    out_.precision(12);
+    write_signals_header(out_, r);
+  }
+  write_signals_row(out_, r, r.t.size() - 1);
+  out_.flush();
+}
+
+void SignalsCsvStream::finish() {
+  out_.close();
+  std::filesystem::rename(partial_, path_);
+  done_ = true;
 }
 
 std::string objectives_json(const engine::RunResult& r) {
