@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/framework/diagram.hpp"
 #include "tests/apps/cli_fixture.hpp"
 
 namespace dydp::test {
@@ -205,6 +206,7 @@ outputs: [src.y]
 // finite objectives.
 TEST_F(Cli, EveryScenarioRuns) {
   int count = 0;
+  size_t objectives_seen = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(DYDP_SOURCE_DIR) / "scenarios")) {
     if (entry.path().extension() != ".yaml") continue;
     // The full car's 20 s on the rig takes about a minute in an optimised build: the sanitizer
@@ -222,11 +224,16 @@ TEST_F(Cli, EveryScenarioRuns) {
     const Result r = dydp("run " + quote(scene) + " --out " + quote(out.string()));
     ASSERT_EQ(r.status, 0) << entry.path() << "\n" << r.err;
     const json objectives = json::parse(read_text(out / "objectives.json"))["objectives"];
+    // Every objective the scene declares, not an empty list the loop below would pass on.
+    EXPECT_EQ(objectives.size(), dydp::engine::load_scene(scene).objectives.size()) << entry.path();
     for (const auto& [name, o] : objectives.items())
       EXPECT_TRUE(std::isfinite(o["value"].get<double>())) << entry.path() << " " << name;
+    objectives_seen += objectives.size();
     ++count;
   }
   EXPECT_GE(count, 6);
+  // cornering_arb 4, quarter_car_cdc 3, fourposter_comfort 2, msd_sensitivity 1
+  EXPECT_GE(objectives_seen, 10u);
 }
 
 }  // namespace
