@@ -8,6 +8,7 @@
 #include <QLineEdit>
 #include <QMenuBar>
 #include <QMessageBox>
+#include <QScrollArea>
 #include <QStatusBar>
 #include <QTabWidget>
 #include <QToolBar>
@@ -31,7 +32,13 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   scene_panel_ = new ScenePanel(&controller_);
   auto* tabs = new QTabWidget;
   tabs->addTab(properties_, tr("Block"));
-  tabs->addTab(scene_panel_, tr("Scene"));
+  // Scrolled: the panel lists every solver key, taller than a small window's dock, and its
+  // height must not squeeze the canvas.
+  auto* scene_scroll = new QScrollArea;
+  scene_scroll->setWidget(scene_panel_);
+  scene_scroll->setWidgetResizable(true);
+  scene_scroll->setFrameShape(QFrame::NoFrame);
+  tabs->addTab(scene_scroll, tr("Scene"));
   auto* right_dock = new QDockWidget(tr("Properties"));
   right_dock->setObjectName("properties");
   right_dock->setWidget(tabs);

@@ -14,6 +14,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "engine/scene/scene_keys.hpp"
+
 namespace dydp::gui {
 
 /// One undo step: the document before and after the edit.
@@ -416,9 +418,10 @@ QString SceneController::set_solver(const QString& key, const QString& text) {
     static const QStringList methods = {"bdf", "adams", "rk4", "sdirk2", "rosw"};
     if (!text.isEmpty() && !methods.contains(text))
       return tr("solver.method: unknown method '%1' (%2)").arg(text, methods.join(", "));
-  } else if (key == "sens_error_test") {
+  } else if (std::find(engine::kSolverSwitches.begin(), engine::kSolverSwitches.end(), s(key)) !=
+             engine::kSolverSwitches.end()) {
     if (!text.isEmpty() && text != "true" && text != "false")
-      return tr("solver.sens_error_test: expected true or false");
+      return tr("solver.%1: expected true or false").arg(key);
   } else {
     double v = 0;
     if (!text.isEmpty() && !engine::parse_number(s(text), v))

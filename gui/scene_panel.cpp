@@ -6,6 +6,9 @@
 #include <QHeaderView>
 #include <QPushButton>
 #include <QVBoxLayout>
+#include <algorithm>
+
+#include "engine/scene/scene_keys.hpp"
 
 namespace dydp::gui {
 namespace {
@@ -34,7 +37,7 @@ ScenePanel::ScenePanel(SceneController* controller, QWidget* parent)
 
   auto* time_box = new QGroupBox(tr("Time [s]"));
   auto* time_form = new QFormLayout(time_box);
-  for (const char* key : {"start", "stop", "output_step"}) {
+  for (const char* key : engine::kTimeKeys) {
     auto* e = new QLineEdit;
     time_[key] = e;
     time_form->addRow(key, e);
@@ -53,9 +56,14 @@ ScenePanel::ScenePanel(SceneController* controller, QWidget* parent)
   connect(method_, &QComboBox::currentTextChanged, this, [this](const QString& m) {
     if (!refreshing_) report(controller_->set_solver("method", m));
   });
-  for (const char* key : {"rtol", "atol", "step", "max_steps"}) {
+  // Every key of `solver:` the loader accepts (method above): a scene's settings are all shown
+  // and editable, not only the tolerances.
+  for (const char* key : engine::kSolverKeys) {
+    if (std::string_view(key) == "method") continue;
+    const bool is_switch = std::find(engine::kSolverSwitches.begin(), engine::kSolverSwitches.end(),
+                                     std::string_view(key)) != engine::kSolverSwitches.end();
     auto* e = new QLineEdit;
-    e->setPlaceholderText(tr("default"));
+    e->setPlaceholderText(is_switch ? tr("default (true or false)") : tr("default"));
     solver_[key] = e;
     solver_form->addRow(key, e);
     connect(e, &QLineEdit::editingFinished, this, [this, key, e] {

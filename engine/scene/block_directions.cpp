@@ -7,6 +7,7 @@
 
 #include "engine/framework/errors.hpp"
 #include "engine/scene/block_reader.hpp"
+#include "engine/scene/scene_keys.hpp"
 
 namespace dydp::engine {
 namespace {
@@ -69,7 +70,7 @@ std::vector<DirectionEntry> read_direction_entries(const YAML::Node& list, const
       throw InputError(file, e.line, field, "expected a name or a mapping {name, of, range, unit}");
     for (auto kv : item) {
       const std::string key = kv.first.Scalar();
-      if (key != "name" && key != "of" && key != "range" && key != "unit")
+      if (std::find(kDirectionKeys.begin(), kDirectionKeys.end(), key) == kDirectionKeys.end())
         throw InputError(file, line_of(kv.first), field + "." + key, "unknown key (name, of, range, unit)");
     }
     const YAML::Node of = item["of"];

@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 
@@ -14,6 +15,7 @@
 #include "engine/scene/duplicate_keys.hpp"
 #include "engine/scene/graph_builder.hpp"
 #include "engine/scene/scene_flattener.hpp"
+#include "engine/scene/scene_keys.hpp"
 #include "engine/scene/scene_relations.hpp"
 #include "engine/scene/subsystem_definition.hpp"
 
@@ -44,8 +46,8 @@ class SceneReader {
     return n.Scalar();
   }
 
-  void allow_keys(const YAML::Node& map, const std::string& field,
-                  std::initializer_list<const char*> keys) const {
+  template <size_t N>
+  void allow_keys(const YAML::Node& map, const std::string& field, const std::array<const char*, N>& keys) const {
     if (!map.IsMap()) fail(map, field, "expected a mapping");
     for (auto kv : map) {
       const std::string key = kv.first.Scalar();
@@ -62,7 +64,7 @@ class SceneReader {
 
 void read_time(const SceneReader& r, const YAML::Node& n, TimeSpec& time) {
   if (!n) return;
-  r.allow_keys(n, "time", {"start", "stop", "output_step"});
+  r.allow_keys(n, "time", kTimeKeys);
   if (n["start"]) time.start = r.number(n["start"], "time.start");
   if (n["stop"]) time.stop = r.number(n["stop"], "time.stop");
   if (n["output_step"]) time.output_step = r.number(n["output_step"], "time.output_step");
@@ -76,9 +78,7 @@ void read_time(const SceneReader& r, const YAML::Node& n, TimeSpec& time) {
 
 void read_solver(const SceneReader& r, const YAML::Node& n, const TimeSpec& time, SolverSpec& s) {
   if (!n) return check_solver_relations(r.file(), n, s, time);
-  r.allow_keys(n, "solver",
-               {"method", "rtol", "atol", "step", "max_steps", "min_step", "sens_error_test", "nominal_scaling",
-                "newton_coefficient", "refresh_local_jacobians", "max_order"});
+  r.allow_keys(n, "solver", kSolverKeys);
   if (n["method"]) {
     s.method = r.text(n["method"], "solver.method");
     if (s.method != "bdf" && s.method != "adams" && s.method != "rk4" && s.method != "sdirk2" &&
@@ -88,20 +88,15 @@ void read_solver(const SceneReader& r, const YAML::Node& n, const TimeSpec& time
   if (n["rtol"]) s.rtol = r.number(n["rtol"], "solver.rtol");
   if (n["atol"]) s.atol = r.number(n["atol"], "solver.atol");
   if (n["step"]) s.step = r.number(n["step"], "solver.step");
-  if (const YAML::Node e = n["sens_error_test"]) {
-    const std::string v = r.text(e, "solver.sens_error_test");
-    if (v != "true" && v != "false") r.fail(e, "solver.sens_error_test", "expected true or false");
-    s.sens_error_test = v == "true";
-  }
-  if (const YAML::Node e = n["nominal_scaling"]) {
-    const std::string v = r.text(e, "solver.nominal_scaling");
-    if (v != "true" && v != "false") r.fail(e, "solver.nominal_scaling", "expected true or false");
-    s.nominal_scaling = v == "true";
-  }
-  if (const YAML::Node e = n["refresh_local_jacobians"]) {
-    const std::string v = r.text(e, "solver.refresh_local_jacobians");
-    if (v != "true" && v != "false") r.fail(e, "solver.refresh_local_jacobians", "expected true or false");
-    s.refresh_local_jacobians = v == "true";
+  bool* const switches[] = {&s.sens_error_test, &s.nominal_scaling, &s.refresh_local_jacobians};
+  static_assert(std::size(switches) == kSolverSwitches.size(), "one member per key of kSolverSwitches");
+  for (size_t i = 0; i < kSolverSwitches.size(); ++i) {
+    const YAML::Node e = n[kSolverSwitches[i]];
+    if (!e) continue;
+    const std::string field = std::string("solver.") + kSolverSwitches[i];
+    const std::string v = r.text(e, field);
+    if (v != "true" && v != "false") r.fail(e, field, "expected true or false");
+    *switches[i] = v == "true";
   }
   if (n["max_steps"]) {
     const double v = r.number(n["max_steps"], "solver.max_steps");
@@ -139,7 +134,7 @@ void read_parameters(const SceneReader& r, const YAML::Node& n, Diagram& d) {
     if (body.IsScalar()) {
       p.value = r.number(body, field);
     } else {
-      r.allow_keys(body, field, {"value", "unit", "range", "description"});
+      r.allow_keys(body, field, kSceneParameterKeys);
       if (!body["value"]) r.fail(body, field + ".value", "missing");
       p.value = r.number(body["value"], field + ".value");
       if (body["unit"]) p.unit = r.text(body["unit"], field + ".unit");
@@ -178,9 +173,7 @@ Diagram load_scene(const std::string& path,
   }
   if (!root.IsMap()) throw InputError(path, 1, "", "a scene is a YAML mapping");
   refuse_duplicate_keys(root, path);
-  r.allow_keys(root, "", {"scene", "description", "time", "solver", "parameters",
-                               "sensitivities", "directions", "subsystems", "blocks", "connections", "outputs",
-                          "layout"});
+  r.allow_keys(root, "", kSceneKeys);
 
   Diagram d;
   d.file = path;

@@ -25,6 +25,8 @@ inline std::string diagram_meaning(const engine::Diagram& d) {
   s << "solver " << d.solver.method << " " << exact(d.solver.rtol) << " " << exact(d.solver.atol) << " "
     << exact(d.solver.step) << " " << d.solver.max_steps << " " << d.solver.sens_error_test << " "
     << exact(d.solver.min_step) << " " << d.solver.nominal_scaling << "\n";
+  s << "solver newton_coefficient " << exact(d.solver.newton_coefficient) << " max_order " << d.solver.max_order
+    << " refresh_local_jacobians " << d.solver.refresh_local_jacobians << "\n";
   for (const auto& p : d.parameters)
     s << "parameter " << p.name << " = " << exact(p.value) << " [" << p.unit << "] in [" << exact(p.lower)
       << ", " << exact(p.upper) << "]\n";

@@ -8,7 +8,9 @@
 #include <QTemporaryDir>
 #include <QtTest>
 
+#include "engine/scene/scene_keys.hpp"
 #include "gui/main_window.hpp"
+#include "gui/scene_controller.hpp"
 
 using namespace dydp::gui;
 
@@ -48,6 +50,23 @@ class GuiEditing : public QObject {
   Q_OBJECT
 
  private slots:
+  // Every key of `solver:` can be set from the scene panel; the switches take true or false,
+  // refresh_local_jacobians and nominal_scaling included (they were read as numbers).
+  void every_solver_key_is_set_and_switches_take_true_or_false() {
+    dydp::gui::SceneController c;
+    c.new_scene();
+    for (const char* key : dydp::engine::kSolverSwitches) {
+      QCOMPARE(c.set_solver(key, "false"), QString());
+      QVERIFY(c.set_solver(key, "0.5").contains("expected true or false"));
+    }
+    QCOMPARE(c.set_solver("max_order", "3"), QString());
+    QCOMPARE(c.set_solver("newton_coefficient", "0.25"), QString());
+    QVERIFY(c.set_solver("newton_coefficient", "false").contains("malformed number"));
+    for (const char* key : {"sens_error_test", "nominal_scaling", "refresh_local_jacobians"})
+      QCOMPARE(QString::fromStdString(*dydp::gui::find_field(c.document().solver, key)), QString("false"));
+    QCOMPARE(QString::fromStdString(*dydp::gui::find_field(c.document().solver, "max_order")), QString("3"));
+  }
+
   void palette_lists_every_registered_type_in_sections() {
     MainWindow w;
     const QStringList sections = w.palette()->sections();

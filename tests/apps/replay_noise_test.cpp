@@ -8,8 +8,11 @@
 // The same with replay's own integrator, Rosenbrock-W (rosw) at 2.5 ms, and at one step per
 // sample (2 ms), on white noise sampled at 500 Hz: both complete without a halved step (before the
 // dampers' rows were solved exactly in each stage, rosw stopped at 2 ms after halving six times
-// and needed 0.25 ms), and their objectives and sensitivities are checked against a BDF replay of
-// the same file at rtol 1e-9.
+// and needed 0.25 ms), and their objectives and sensitivities are checked against a reference
+// that is not a replay: `dydp run` with BDF at rtol 1e-9 of the scene with the recording named in
+// its rig's input_file (so a replay that ignored its recording would not match it either).
+// Every objectives.json is checked to hold the scene's two objectives and their sensitivity, so
+// that no loop over them passes on an empty list.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -53,7 +56,26 @@ class ReplayNoise : public DydpProcessTest {
     for (int i = 0; i < 2; ++i) scene.replace(scene.find("window: [2.0, 20.0]"), 19, "window: [0.5, 2.0]");
     return write("scene.yaml", scene);
   }
+  /// The main scene shortened to 2 s, its rig reading `recording` (input_file, as replay sets it).
+  std::string scene_reading(const std::string& recording) {
+    const std::string scene = read_text(short_scene());
+    return write("reference.yaml", replaced(scene, "noise_high: 10.0}", "noise_high: 10.0, input_file: " + recording + "}"));
+  }
 };
+
+/// objectives.json's objectives: name -> (value, d/d(valve_current)); fails the test unless
+/// there are the scene's two (comfort, comfort_wk), each with its finite sensitivity.
+std::map<std::string, std::pair<double, double>> objectives_of(const fs::path& out) {
+  std::map<std::string, std::pair<double, double>> m;
+  const json o = json::parse(read_text(out / "objectives.json"))["objectives"];
+  EXPECT_EQ(o.size(), 2u) << out << ": " << o.dump();
+  for (const auto& [name, v] : o.items()) {
+    EXPECT_TRUE(v["sensitivity"].contains("valve_current")) << out << ": " << name;
+    m[name] = {v["value"].get<double>(), v["sensitivity"].value("valve_current", NAN)};
+    EXPECT_TRUE(std::isfinite(m[name].first) && std::isfinite(m[name].second)) << out << ": " << name;
+  }
+  return m;
+}
 
 TEST_F(ReplayNoise, FixedStepReplayOfANoisyRecordingCompletesWithHalvedSteps) {
   const std::string input = noisy_recording(0.005);  // 200 Hz
@@ -65,28 +87,21 @@ TEST_F(ReplayNoise, FixedStepReplayOfANoisyRecordingCompletesWithHalvedSteps) {
   const json run = json::parse(read_text(out / "run.json"));
   EXPECT_GT(run["substeps"].get<long>(), 0) << "no step needed halving: the test no longer reaches the case";
   const json objectives = json::parse(read_text(out / "objectives.json"))["objectives"];
+  ASSERT_EQ(objectives.size(), 2u) << objectives.dump();
   for (const auto& [name, o] : objectives.items()) {
     EXPECT_TRUE(std::isfinite(o["value"].get<double>())) << name;
     EXPECT_GT(o["value"].get<double>(), 0.0) << name;
+    ASSERT_FALSE(o["sensitivity"].empty()) << name;
     for (const auto& [direction, s] : o["sensitivity"].items()) EXPECT_TRUE(std::isfinite(s.get<double>())) << name;
   }
-}
-
-/// objectives.json's objectives: name -> (value, d/d(valve_current)).
-std::map<std::string, std::pair<double, double>> objectives_of(const fs::path& out) {
-  std::map<std::string, std::pair<double, double>> m;
-  const json o = json::parse(read_text(out / "objectives.json"))["objectives"];
-  for (const auto& [name, v] : o.items())
-    m[name] = {v["value"].get<double>(), v["sensitivity"]["valve_current"].get<double>()};
-  return m;
 }
 
 TEST_F(ReplayNoise, ReplayIsRosenbrockWAndFollowsBdfAtOneStepPerSampleAndAt2p5Ms) {
   const std::string input = noisy_recording(0.002);  // 500 Hz
   const std::string path = short_scene();
   const fs::path reference = dir_ / "bdf";
-  ProcessResult r = dydp("replay " + quote(path) + " --input " + quote(input) +
-                         " --solver bdf --rtol 1e-9 --atol 1e-9 --out " + quote(reference.string()));
+  ProcessResult r = dydp("run " + quote(scene_reading(input)) + " --rtol 1e-9 --atol 1e-9 --out " +
+                         quote(reference.string()));
   ASSERT_EQ(r.status, 0) << r.err;
   const auto ref = objectives_of(reference);
   ASSERT_EQ(ref.size(), 2u);
@@ -113,7 +128,10 @@ TEST_F(ReplayNoise, ReplayIsRosenbrockWAndFollowsBdfAtOneStepPerSampleAndAt2p5Ms
     EXPECT_DOUBLE_EQ(run["fixed_step"].get<double>(), c.step_s);
     EXPECT_EQ(run["substeps"].get<long>(), 0) << c.options;
     EXPECT_GT(run["nonlinear_iterations"].get<long>(), 0) << "the dampers' rows were not iterated";
-    for (const auto& [name, v] : objectives_of(out)) {
+    const auto replayed = objectives_of(out);
+    ASSERT_EQ(replayed.size(), ref.size()) << c.options;
+    for (const auto& [name, v] : replayed) {
+      ASSERT_TRUE(ref.count(name)) << name;
       const auto& [value, sensitivity] = ref.at(name);
       EXPECT_LT(std::fabs(v.first - value), c.value_bound * std::fabs(value)) << name << " at " << c.step_s;
       EXPECT_LT(std::fabs(v.second - sensitivity), c.sensitivity_bound * std::fabs(sensitivity))
@@ -134,8 +152,10 @@ TEST_F(ReplayNoise, RosenbrockAtAQuarterMillisecondCompletes) {
   EXPECT_EQ(run["steps"].get<long>(), 8000 + run["substeps"].get<long>());  // a halving adds one step
   EXPECT_GT(run["local_jacobian_refreshes"].get<long>(), 0);
   const json objectives = json::parse(read_text(out / "objectives.json"))["objectives"];
+  ASSERT_EQ(objectives.size(), 2u) << objectives.dump();
   for (const auto& [name, o] : objectives.items()) {
     EXPECT_GT(o["value"].get<double>(), 0.0) << name;
+    ASSERT_FALSE(o["sensitivity"].empty()) << name;
     for (const auto& [direction, s] : o["sensitivity"].items()) EXPECT_TRUE(std::isfinite(s.get<double>())) << name;
   }
 }

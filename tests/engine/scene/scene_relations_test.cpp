@@ -422,7 +422,7 @@ outputs: [rig.z]
 
 TEST_F(SceneRelations, ShippedScenesLoadWithoutWarnings) {
   // The rules must not fire on the scenes users start from (the stress scenes among them);
-  // cli_test's EveryScenarioRuns runs them.
+  // cli_run_test's EveryScenarioRuns runs them.
   int count = 0;
   for (const auto& e : fs::recursive_directory_iterator(fs::path(DYDP_SOURCE_DIR) / "scenarios")) {
     // scenarios/subsystems/ holds the subsystems the scenes include, not scenes.

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "generated_models/registry.hpp"
+#include "model_cases.hpp"
 #include "oracle_compare.hpp"
 #include "symbolic/mbs/numeric_dynamics.hpp"
 
@@ -258,31 +259,35 @@ void check_function(const char* what, const Fixture& f, GeneratedTangent tangent
 }
 
 class Tangents : public ::testing::TestWithParam<std::string> {};
+// The same tests on the models they apply to only (instantiated below from models_where).
+class TangentsWithSensors : public Tangents {};
+class TangentsWithConstraints : public Tangents {};
+class TangentsWithCoordinateGroups : public Tangents {};
 
-TEST_P(Tangents, SensorsMatchCentralDifferencesOfTheOracle) {
+TEST_P(TangentsWithSensors, SensorsMatchCentralDifferencesOfTheOracle) {
   Fixture f(GetParam());
   ASSERT_NE(f.g, nullptr);
   const GeneratedModel& g = *f.g;
-  if (g.sensor_outputs == 0) GTEST_SKIP() << g.name << " has no sensors";
+  ASSERT_GT(g.sensor_outputs, 0) << g.name << " has no sensors";
   NumericDynamics oracle(f.model);
   const Reference generated = [&g](const Args& x) { return generated_outputs(g.sensors, g.sensor_outputs, x); };
   check_function("sensors", f, g.sensors_tangent, g.sensor_outputs, generated, oracle_sensors(oracle, g), 1e-13, 21);
 }
 
-TEST_P(Tangents, VelocityConstraintsMatchCentralDifferencesOfConstraints) {
+TEST_P(TangentsWithConstraints, VelocityConstraintsMatchCentralDifferencesOfConstraints) {
   Fixture f(GetParam());
   ASSERT_NE(f.g, nullptr);
   const GeneratedModel& g = *f.g;
-  if (g.m == 0) GTEST_SKIP() << g.name << " has no constraints";
+  ASSERT_GT(g.m, 0) << g.name << " has no constraints";
   check_function("velocity constraints", f, g.velocity_constraints_tangent, 2 * g.m, velocity_constraints(g),
                  velocity_constraints(g), 1e-13, 22);
 }
 
-TEST_P(Tangents, PositionConstraintsMatchCentralDifferencesOfConstraints) {
+TEST_P(TangentsWithConstraints, PositionConstraintsMatchCentralDifferencesOfConstraints) {
   Fixture f(GetParam());
   ASSERT_NE(f.g, nullptr);
   const GeneratedModel& g = *f.g;
-  if (g.m == 0) GTEST_SKIP() << g.name << " has no constraints";
+  ASSERT_GT(g.m, 0) << g.name << " has no constraints";
   check_function("position constraints", f, g.constraints_tangent, g.m, position_constraints(g),
                  position_constraints(g), 1e-13, 25);
 }
@@ -327,12 +332,14 @@ TEST_P(Tangents, ResidualVelocityTangentMatchesCentralDifferencesAndTheFullTange
 // q's, a group's position block the group's q, qd and qdd, its velocity block the group's qd
 // and qdd): its out is the residual, and each column equals the full tangent's for that seed.
 // The sedan must have groups (its corners, wheels and the chassis' coordinates).
-TEST_P(Tangents, ResidualTangentInBlocksIsTheFullTangentOnEachBlocksSeeds) {
+TEST_P(TangentsWithCoordinateGroups, ResidualTangentInBlocksIsTheFullTangentOnEachBlocksSeeds) {
   Fixture f(GetParam());
   ASSERT_NE(f.g, nullptr);
   const GeneratedModel& g = *f.g;
-  if (std::string(g.name) == "sedan") ASSERT_GE(g.tangent_groups, 8);
-  if (!g.residual_tangent_groups) GTEST_SKIP() << g.name << " has no coordinate groups";
+  if (std::string(g.name) == "sedan") {
+    ASSERT_GE(g.tangent_groups, 8);
+  }
+  ASSERT_TRUE(g.residual_tangent_groups) << g.name << " has no coordinate groups";
   std::vector<Direction> dirs;
   std::vector<int> per_block;
   auto add_block = [&](auto keep) {
@@ -371,6 +378,23 @@ TEST_P(Tangents, ResidualTangentInBlocksIsTheFullTangentOnEachBlocksSeeds) {
 
 INSTANTIATE_TEST_SUITE_P(Models, Tangents, ::testing::Values(DYDP_TEST_MODELS),
                          [](const auto& info) { return info.param; });
+INSTANTIATE_TEST_SUITE_P(Models, TangentsWithSensors, ::testing::ValuesIn(models_where({DYDP_TEST_MODELS}, has_sensors)),
+                         [](const auto& info) { return info.param; });
+INSTANTIATE_TEST_SUITE_P(Models, TangentsWithConstraints,
+                         ::testing::ValuesIn(models_where({DYDP_TEST_MODELS}, has_constraints)),
+                         [](const auto& info) { return info.param; });
+INSTANTIATE_TEST_SUITE_P(Models, TangentsWithCoordinateGroups,
+                         ::testing::ValuesIn(models_where({DYDP_TEST_MODELS}, has_coordinate_groups)),
+                         [](const auto& info) { return info.param; });
+
+// The filtered lists are not empty, and the sedan (whose corners, wheels and chassis make
+// coordinate groups) is among the grouped models: a filter cannot drop the cases it is for.
+TEST(TangentCases, EachFilteredListHasItsModels) {
+  EXPECT_FALSE(models_where({DYDP_TEST_MODELS}, has_sensors).empty());
+  EXPECT_FALSE(models_where({DYDP_TEST_MODELS}, has_constraints).empty());
+  const std::vector<std::string> grouped = models_where({DYDP_TEST_MODELS}, has_coordinate_groups);
+  EXPECT_NE(std::find(grouped.begin(), grouped.end(), "sedan"), grouped.end());
+}
 
 // The check fails on a wrong tangent: on the sedan, the largest entry of each tangent off by a
 // relative 1e-5, and a sensor given a derivative by an input (which it must not read).
