@@ -1,6 +1,7 @@
 // The dydp subcommands, each a function of its parsed arguments returning the exit status.
 #pragma once
 
+#include <cmath>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -68,7 +69,26 @@ struct ScreenArgs {
   int threads = 0;                ///< --threads: 0 one per core (one per rank under MPI)
 };
 
+/// equilibrium, linearize, modes, frf: the analyses about one operating point.
+struct LinearArgs {
+  std::string scene;
+  std::string out = "out";
+  std::vector<std::string> sets;
+  double time = std::nan("");          ///< --time: the inputs held at their values then (default t0)
+  double at = std::nan("");            ///< linearize --at T: about the run's state at T, not the equilibrium
+  std::vector<std::string> inputs;     ///< --input: signals (frf: SIGNAL or SIGNAL:RATE_SIGNAL)
+  std::vector<std::string> outputs;    ///< --output: signals (linearize: default the logged ones)
+  std::string frequencies = "0.5:30:60";  ///< frf --frequencies LO:HI:N [Hz], log spaced
+  double max_frequency = 30.0;         ///< modes: the terminal table's highest frequency [Hz]
+  bool report = false;
+  std::string format = "csv";          ///< csv | mat
+};
+
 int run_command(const RunArgs& args);
+int equilibrium_command(const LinearArgs& args);
+int linearize_command(const LinearArgs& args);
+int modes_command(const LinearArgs& args);
+int frf_command(const LinearArgs& args);
 int screen_command(const ScreenArgs& args);
 int replay_command(const ReplayArgs& args);
 int accuracy_command(const AccuracyArgs& args);

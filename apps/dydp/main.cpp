@@ -103,6 +103,31 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   add_solver_options(screen, screen_args.solver);
 
+  // The analyses about one operating point (engine/linear/).
+  dydp::apps::LinearArgs linear_args;
+  auto add_linear = [&](const char* name, const char* what) {
+    CLI::App* c = app.add_subcommand(name, what);
+    c->add_option("scene", linear_args.scene, "scene file (YAML)")->required();
+    c->add_option("--out", linear_args.out, "output folder")->capture_default_str();
+    c->add_option("--set", linear_args.sets, "override a scene parameter: NAME=VALUE");
+    c->add_option("--time", linear_args.time, "hold the inputs at their values at this time [s] (default: the scene's start)");
+    c->add_option("--format", linear_args.format, "csv: the CSV/JSON files; mat: also a MAT v5 file")
+        ->check(CLI::IsMember({"csv", "mat"}))->capture_default_str();
+    return c;
+  };
+  CLI::App* equilibrium = add_linear("equilibrium", "Static equilibrium with the inputs held, and dx*/dp for every parameter");
+  CLI::App* linearize = add_linear("linearize", "A, B, C, D of the whole diagram about its equilibrium (or a time of a run)");
+  linearize->add_option("--input", linear_args.inputs, "input signal BLOCK.PORT or BLOCK.PORT[i] (its wire cut)");
+  linearize->add_option("--output", linear_args.outputs, "output signal (default: the scene's logged signals)");
+  linearize->add_option("--at", linear_args.at, "about the run's state at this time [s] instead of the equilibrium");
+  CLI::App* modes = add_linear("modes", "Ride modes: eigenvalues, frequencies, damping ratios, dominant states, d(lambda)/dp");
+  modes->add_option("--max-frequency", linear_args.max_frequency, "the terminal table's highest frequency [Hz]")->capture_default_str();
+  CLI::App* frf = add_linear("frf", "Frequency response from one input to outputs, with d|H|/dp");
+  frf->add_option("--input", linear_args.inputs, "input SIGNAL or SIGNAL:RATE_SIGNAL (e.g. rig.z:rig.zdot, the pads' heave)")->required();
+  frf->add_option("--output", linear_args.outputs, "output signals")->required();
+  frf->add_option("--frequencies", linear_args.frequencies, "LO:HI:N [Hz], log spaced")->capture_default_str();
+  frf->add_flag("--report", linear_args.report, "also write the plot (gnuplot) and report.md");
+
   CLI::App* blocks = app.add_subcommand("blocks", "List the block types with ports and parameters; [direction]: a parameter that can be a "
       "sensitivity direction, written BLOCK.PARAMETER in a scene's sensitivities: list");
 
@@ -120,6 +145,10 @@ int main(int argc, char** argv) {
     accuracy_args.methods_given = accuracy->count("--methods") > 0;
     if (*accuracy) return dydp::apps::accuracy_command(accuracy_args);
     if (*replay) return dydp::apps::replay_command(replay_args);
+    if (*equilibrium) return dydp::apps::equilibrium_command(linear_args);
+    if (*linearize) return dydp::apps::linearize_command(linear_args);
+    if (*modes) return dydp::apps::modes_command(linear_args);
+    if (*frf) return dydp::apps::frf_command(linear_args);
     if (*blocks) return dydp::apps::blocks_command(std::cout);
   } catch (const dydp::engine::InputError& e) {
     err << e.what() << "\n";

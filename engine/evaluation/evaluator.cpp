@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 
 namespace dydp::engine {
 namespace {
@@ -180,12 +181,13 @@ void Evaluator::tangents(double t, const double* x, int nd, ConstDirView dx, boo
       const auto& ports = n.block->outputs();
       for (int k : step.outputs)
         for (int d = 0; d < nd; ++d) std::fill_n(dy_[k].data + d * ld, ports[k].width, 0.0);
-      continue;
+    } else {
+      Eval e = eval_for(n, i, t, x);
+      e.ready = step.ready.data();
+      e.inputs_ready = step.inputs_ready;
+      call_block(n, [&] { n.block->outputs_tangent(e, s, dy_.data()); });
     }
-    Eval e = eval_for(n, i, t, x);
-    e.ready = step.ready.data();
-    e.inputs_ready = step.inputs_ready;
-    call_block(n, [&] { n.block->outputs_tangent(e, s, dy_.data()); });
+    if (num_seeded_ > 0) seed_signals(n, step, nd);
   }
   for (size_t i = 0; i < d_.nodes.size(); ++i) {
     const Node& n = d_.nodes[i];
@@ -199,6 +201,29 @@ void Evaluator::tangents(double t, const double* x, int nd, ConstDirView dx, boo
       if (states) n.block->derivatives_tangent(e, s, {dxdot.data + n.state_offset, dxdot.ld});
       if (quads) n.block->quadratures_tangent(e, s, {dqdot.data + n.quad_offset, dqdot.ld});
     });
+  }
+}
+
+void Evaluator::set_signal_seeds(std::vector<int> offsets, std::vector<double> seeds) {
+  seeded_.assign(d_.num_signals, -1);
+  num_seeded_ = static_cast<int>(offsets.size());
+  for (int j = 0; j < num_seeded_; ++j) seeded_.at(offsets[j]) = j;
+  signal_seeds_ = std::move(seeds);
+}
+
+void Evaluator::seed_signals(const Node& n, const OutputStep& step, int nd) {
+  const int ld = d_.num_signals;
+  if (signal_seeds_.size() != static_cast<size_t>(num_seeded_) * nd)
+    throw std::logic_error("Evaluator: signal seeds for another number of directions");
+  const auto& ports = n.block->outputs();
+  for (int k : step.outputs) {
+    const int offset = n.output_offset[k];
+    for (int w = 0; w < ports[k].width; ++w) {
+      const int j = seeded_[offset + w];
+      if (j < 0) continue;
+      zero_tangent_[offset] = false;
+      for (int d = 0; d < nd; ++d) dsig_[static_cast<size_t>(d) * ld + offset + w] = signal_seeds_[d * num_seeded_ + j];
+    }
   }
 }
 

@@ -40,6 +40,12 @@ class Evaluator {
   void tangents(double t, const double* x, int nd, ConstDirView dx, bool with_params,
                 DirView dxdot, DirView dqdot);
 
+  /// Signals whose tangents the tangent pass sets instead of computing them: signal offsets[j]
+  /// gets seeds[d * offsets.size() + j] in direction d, whatever its block would give (the wire
+  /// cut there, the signal a free input: a linearisation's inputs). Every tangents call must
+  /// then have the seeds' number of directions. Empty offsets: none (the default).
+  void set_signal_seeds(std::vector<int> offsets, std::vector<double> seeds);
+
   /// Overwrites the diagonal block d(xdot_b)/dx_b of jac (column-major, leading dimension ld)
   /// for every block that provides Block::local_jacobian, at (t, x). False when none does.
   bool local_jacobians(double t, const double* x, double* jac, int ld);
@@ -70,6 +76,7 @@ class Evaluator {
  private:
   Eval eval_for(const Node& n, int index, double t, const double* x) const;
   Seeds seeds_for(const Node& n, int index, int nd, ConstDirView dx, bool with_params);
+  void seed_signals(const Node& n, const OutputStep& step, int nd);
 
   const Diagram& d_;
   int ns_ = 0;
@@ -95,6 +102,9 @@ class Evaluator {
   std::vector<int> local_nodes_;                   ///< their nodes
   double last_t_ = 0.0;
   std::vector<double> last_x_;
+  std::vector<int> seeded_;            ///< per signal: its column in signal_seeds_, or -1
+  std::vector<double> signal_seeds_;   ///< see set_signal_seeds
+  int num_seeded_ = 0;
 };
 
 }  // namespace dydp::engine

@@ -17,6 +17,7 @@ ALLOWED = {
     "engine/scene": ["engine/framework"],
     "engine/evaluation": ["engine/framework"],
     "engine/analysis": ["engine/framework", "engine/evaluation"],
+    "engine/linear": ["engine/framework", "engine/evaluation", "engine/analysis"],
     "io": ["engine/framework", "engine/analysis/run_result.hpp"],
     "engine/studies": ["engine/framework", "engine/scene", "engine/evaluation", "engine/analysis", "io"],
     "blocks": ["engine/framework", "io", "generated_models", "symbolic"],

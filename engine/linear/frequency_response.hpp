@@ -1,0 +1,33 @@
+// The frequency response of a linear model: H(j w) = C (j w I - A)^-1 b(j w) + d(j w) from one
+// input to every output, where an input may come with its rate (a pad's height z and its
+// zdot, both inputs of the diagram: b = B_z + j w B_zdot); and d|H|/dp from the model's
+// derivatives, dH = C R dA R b + C R db + dC R b + dd, R = (j w I - A)^-1.
+#pragma once
+
+#include <complex>
+#include <vector>
+
+#include "engine/linear/linearization.hpp"
+
+namespace dydp::engine {
+
+struct FrequencyInput {
+  int input = 0;      ///< column of B and D
+  int rate = -1;      ///< column whose signal is the input's time derivative, or -1
+};
+
+struct FrequencyResponse {
+  std::vector<double> frequency_hz;
+  /// H[f][o]: output o at frequency f
+  std::vector<std::vector<std::complex<double>>> H;
+  /// dmagnitude[p][f][o]: d|H|/dp per parameter given
+  std::vector<std::vector<std::vector<double>>> dmagnitude;
+};
+
+FrequencyResponse frequency_response(const LinearModel& m, FrequencyInput input, const std::vector<double>& frequency_hz,
+                                     const std::vector<LinearModelDerivative>& derivatives = {});
+
+/// n frequencies from lo to hi [Hz], log spaced (n >= 2).
+std::vector<double> log_frequencies(double lo, double hi, int n);
+
+}  // namespace dydp::engine

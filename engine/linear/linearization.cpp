@@ -1,0 +1,143 @@
+#include "engine/linear/linearization.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/analysis/tolerances.hpp"
+#include "engine/evaluation/evaluator.hpp"
+#include "engine/framework/errors.hpp"
+#include "engine/linear/signal_lookup.hpp"
+
+namespace dydp::engine {
+
+std::vector<int> differentiable_parameters(const Diagram& d) {
+  std::vector<int> out;
+  for (int i = 0; i < static_cast<int>(d.parameters.size()); ++i) {
+    try {
+      check_differentiable(d.nodes, d, {i});
+      out.push_back(i);
+    } catch (const InputError&) {
+    }
+  }
+  return out;
+}
+
+Eigen::MatrixXd state_jacobian(Evaluator& e, int n, double t, const std::vector<double>& x,
+                               const std::vector<int>& held) {
+  Eigen::MatrixXd A(n, n);
+  if (n == 0) return A;
+  const Eigen::MatrixXd seeds = Eigen::MatrixXd::Identity(n, n);
+  e.set_signal_seeds(held, std::vector<double>(held.size() * n, 0.0));
+  e.tangents(t, x.data(), n, {seeds.data(), n}, false, {A.data(), n}, {});
+  e.set_signal_seeds({}, {});
+  return A;
+}
+
+namespace {
+
+struct Ports {
+  std::vector<std::vector<int>> inputs;  ///< per input: the offsets it moves
+  std::vector<int> held;                 ///< all of them
+  std::vector<int> outputs;              ///< one offset per output row
+};
+
+Ports resolve(const Diagram& d, const std::vector<std::string>& inputs, std::vector<std::string>& outputs) {
+  Ports p;
+  for (const std::string& name : inputs) {
+    p.inputs.push_back(signal_offsets(d, name, "--input"));
+    for (int o : p.inputs.back()) {
+      if (std::find(p.held.begin(), p.held.end(), o) != p.held.end())
+        throw InputError("--input", 0, name, "names a signal another input already names");
+      p.held.push_back(o);
+    }
+  }
+  std::vector<std::string> rows;
+  if (outputs.empty()) {
+    for (const LoggedSignal& s : d.logged) p.outputs.push_back(s.offset), rows.push_back(s.name);
+  } else {
+    for (const std::string& name : outputs)
+      for (int o : signal_offsets(d, name, "--output")) p.outputs.push_back(o), rows.push_back(signal_name(d, o));
+  }
+  outputs = rows;
+  return p;
+}
+
+}  // namespace
+
+LinearModel linearize(const Diagram& d, double t, const std::vector<double>& x,
+                      const std::vector<std::string>& inputs, const std::vector<std::string>& outputs) {
+  LinearModel m;
+  m.t = t;
+  m.x = x;
+  m.inputs = inputs;
+  m.outputs = outputs;
+  const Ports ports = resolve(d, inputs, m.outputs);
+  const int n = d.num_states, ni = static_cast<int>(inputs.size()), no = static_cast<int>(ports.outputs.size());
+  for (int i = 0; i < n; ++i) m.states.push_back(state_label(d, i));
+  Evaluator e(d, false);
+  e.set_segment_start(t);
+  // A and C: state seeds, the inputs' wires cut (their tangents held at zero).
+  m.A = state_jacobian(e, n, t, x, ports.held);
+  m.C.resize(no, n);
+  if (n > 0) {
+    const Eigen::MatrixXd seeds = Eigen::MatrixXd::Identity(n, n);
+    Eigen::MatrixXd dxdot(n, n);
+    e.set_signal_seeds(ports.held, std::vector<double>(ports.held.size() * n, 0.0));
+    e.tangents(t, x.data(), n, {seeds.data(), n}, false, {dxdot.data(), n}, {});
+    for (int r = 0; r < no; ++r)
+      for (int c = 0; c < n; ++c) m.C(r, c) = e.signal_tangents()[static_cast<size_t>(c) * d.num_signals + ports.outputs[r]];
+  }
+  // B and D: one direction per input, seeding every signal it moves with 1.
+  m.B = Eigen::MatrixXd::Zero(n, ni);
+  m.D = Eigen::MatrixXd::Zero(no, ni);
+  if (ni > 0) {
+    const int nh = static_cast<int>(ports.held.size());
+    std::vector<double> seeds(static_cast<size_t>(nh) * ni, 0.0);
+    for (int j = 0, h = 0; j < ni; ++j)
+      for (size_t k = 0; k < ports.inputs[j].size(); ++k, ++h) seeds[static_cast<size_t>(j) * nh + h] = 1.0;
+    e.set_signal_seeds(ports.held, seeds);
+    e.tangents(t, x.data(), ni, {}, false, {m.B.data(), n}, {});
+    for (int r = 0; r < no; ++r)
+      for (int c = 0; c < ni; ++c) m.D(r, c) = e.signal_tangents()[static_cast<size_t>(c) * d.num_signals + ports.outputs[r]];
+    e.set_signal_seeds({}, {});
+  }
+  return m;
+}
+
+std::vector<double> signal_values(const Diagram& d, double t, const std::vector<double>& x,
+                                  const std::vector<std::string>& names) {
+  Evaluator e(d, false);
+  e.set_segment_start(t);
+  e.outputs(t, x.data());
+  std::vector<double> values;
+  for (const std::string& name : names)
+    for (int o : signal_offsets(d, name, "--output")) values.push_back(e.signals()[o]);
+  return values;
+}
+
+LinearModelDerivative linear_model_derivative(Diagram& d, const LinearModel& m, int parameter,
+                                              const Eigen::VectorXd& dx_dp, double relative_step) {
+  const SceneParameter& sp = d.parameters[parameter];
+  const double p0 = sp.value;
+  const double span = std::isfinite(sp.upper - sp.lower) ? sp.upper - sp.lower : 0.0;
+  const double h = relative_step * std::max({std::fabs(p0), 1e-3 * span, 1e-8});
+  LinearModel at[2];
+  for (int s = 0; s < 2; ++s) {
+    const double sign = s == 0 ? 1.0 : -1.0;
+    std::vector<double> x = m.x;
+    for (size_t i = 0; i < x.size(); ++i) x[i] += sign * h * dx_dp[static_cast<Eigen::Index>(i)];
+    d.set_parameter(parameter, p0 + sign * h, false);
+    try {
+      at[s] = linearize(d, m.t, x, m.inputs, m.outputs);
+    } catch (...) {
+      d.set_parameter(parameter, p0, false);
+      throw;
+    }
+  }
+  d.set_parameter(parameter, p0, false);
+  const double scale = 1.0 / (2 * h);
+  return {(at[0].A - at[1].A) * scale, (at[0].B - at[1].B) * scale, (at[0].C - at[1].C) * scale,
+          (at[0].D - at[1].D) * scale};
+}
+
+}  // namespace dydp::engine
