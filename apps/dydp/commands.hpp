@@ -76,6 +76,7 @@ struct LinearArgs {
   std::vector<std::string> sets;
   double time = std::nan("");          ///< --time: the inputs held at their values then (default t0)
   double at = std::nan("");            ///< linearize --at T: about the run's state at T, not the equilibrium
+  std::vector<std::string> holds;      ///< --hold SIGNAL=VALUE: a signal held at a value
   std::vector<std::string> inputs;     ///< --input: signals (frf: SIGNAL or SIGNAL:RATE_SIGNAL)
   std::vector<std::string> outputs;    ///< --output: signals (linearize: default the logged ones)
   std::string frequencies = "0.5:30:60";  ///< frf --frequencies LO:HI:N [Hz], log spaced

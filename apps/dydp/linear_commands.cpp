@@ -40,6 +40,7 @@ engine::Diagram load(const LinearArgs& args) {
 engine::EquilibriumOptions equilibrium_options(const engine::Diagram& d, const LinearArgs& args) {
   engine::EquilibriumOptions o;
   o.time = std::isnan(args.time) ? d.time.start : args.time;
+  o.held = engine::held_signals(d, args.holds, "--hold");
   if (o.time < d.time.start || o.time > d.time.stop)
     throw engine::InputError("--time", 0, engine::format_number(o.time),
                              "outside the scene's time [" + engine::format_number(d.time.start) + ", " +
@@ -82,7 +83,7 @@ struct Point {
 Point linearize_at_equilibrium(engine::Diagram& d, const LinearArgs& args, bool with_derivatives) {
   Point p;
   p.eq = engine::find_equilibrium(d, equilibrium_options(d, args));
-  p.model = engine::linearize(d, p.eq.t, p.eq.x, args.inputs, args.outputs);
+  p.model = engine::linearize(d, p.eq.t, p.eq.x, args.inputs, args.outputs, p.eq.held);
   if (with_derivatives)
     for (int j = 0; j < static_cast<int>(p.eq.parameters.size()); ++j)
       p.derivatives.push_back(engine::linear_model_derivative(d, p.model, p.eq.parameters[j], p.eq.dx_dp.col(j)));
@@ -105,13 +106,16 @@ int equilibrium_command(const LinearArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   engine::Diagram d = load(args);
   const engine::Equilibrium eq = engine::find_equilibrium(d, equilibrium_options(d, args));
-  const engine::LinearModel logged = engine::linearize(d, eq.t, eq.x, {}, {});
+  const engine::LinearModel logged = engine::linearize(d, eq.t, eq.x, {}, {}, eq.held);
   Json j;
   j["scene"] = d.scene_name;
   j["time"] = eq.t;
   j["residual"] = eq.residual;
   j["residual_unit"] = "nominal units per second (max over states of |xdot| / nominal)";
   j["iterations"] = eq.iterations;
+  Json held = Json::object();
+  for (const auto& [offset, value] : eq.held) held[engine::signal_name(d, offset)] = value;
+  j["held"] = held;
   j["rank_deficiency"] = eq.rank_deficiency;
   Json state = Json::object(), moved = Json::object();
   for (size_t i = 0; i < eq.x.size(); ++i) {
@@ -121,7 +125,7 @@ int equilibrium_command(const LinearArgs& args) {
   j["state"] = state;
   j["moved_from_initial"] = moved;
   Json signals = Json::object();
-  const std::vector<double> values = engine::signal_values(d, eq.t, eq.x, logged.outputs);
+  const std::vector<double> values = engine::signal_values(d, eq.t, eq.x, logged.outputs, eq.held);
   for (size_t k = 0; k < values.size(); ++k) signals[logged.outputs[k]] = values[k];
   j["signals"] = signals;
   Json sens = Json::object();
@@ -163,15 +167,16 @@ int linearize_command(const LinearArgs& args) {
   } else {
     if (!(args.at >= d.time.start && args.at <= d.time.stop))
       throw engine::InputError("--at", 0, engine::format_number(args.at), "outside the scene's time");
-    // Validate the names before the run.
-    std::vector<double> x0(d.num_states, 0.0);
-    engine::linearize(d, args.at, x0, args.inputs, args.outputs);
+    // The names checked before the run.
+    const auto held = engine::held_signals(d, args.holds, "--hold");
+    for (const std::string& name : args.inputs) engine::signal_offsets(d, name, "--input");
+    for (const std::string& name : args.outputs) engine::signal_offsets(d, name, "--output");
     engine::Diagram to = engine::load_scene(args.scene, parse_sets(args.sets));
     to.time.stop = args.at;
     engine::RunOptions o;
     o.sensitivities = false;
     const engine::RunResult r = engine::run(to, o);
-    m = engine::linearize(d, args.at, r.final_state, args.inputs, args.outputs);
+    m = engine::linearize(d, args.at, r.final_state, args.inputs, args.outputs, held);
     about = "the run's state at t = " + engine::format_number(args.at) + " s";
   }
   Json j;
@@ -264,11 +269,17 @@ int modes_command(const LinearArgs& args) {
   }
   std::cout << d.scene_name << ": " << modes.size() << " modes of " << p.model.states.size()
             << " states about the equilibrium\n";
-  int above = 0;
+  int above = 0, rigid = 0;
   std::cout << "  " << std::setw(10) << "f [Hz]" << std::setw(9) << "zeta" << "  dominant states\n";
   for (const engine::Mode& m : modes) {
     if (m.frequency_hz > args.max_frequency) {
       ++above;
+      continue;
+    }
+    // |lambda| below 1e-3 1/s: a coordinate no force holds (a free body's position, a wheel's
+    // spin) or a conserved quantity (the oil in a damper), not a mode of the car.
+    if (std::abs(m.eigenvalue) < 1e-3) {
+      ++rigid;
       continue;
     }
     std::cout << "  " << std::fixed << std::setw(10) << std::setprecision(3) << m.frequency_hz << std::setw(9)
@@ -277,6 +288,7 @@ int modes_command(const LinearArgs& args) {
       std::cout << (k ? ", " : "") << m.dominant[k].first << " " << std::setprecision(2) << 100 * m.dominant[k].second << " %";
     std::cout << "\n";
   }
+  if (rigid) std::cout << "  (" << rigid << " eigenvalues below 1e-3 1/s: coordinates no force holds, conserved quantities; in modes.json)\n";
   if (above) std::cout << "  (" << above << " modes above " << args.max_frequency << " Hz in modes.json)\n";
   print_done("equilibrium, linearisation, modes and d(lambda)/dp for " + std::to_string(names.size()) + " parameters",
              seconds_since(start), args.out, std::string("modes.json, modes.csv") + (args.format == "mat" ? ", modes.mat" : ""));

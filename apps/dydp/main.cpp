@@ -111,6 +111,7 @@ int main(int argc, char** argv) {
     c->add_option("--out", linear_args.out, "output folder")->capture_default_str();
     c->add_option("--set", linear_args.sets, "override a scene parameter: NAME=VALUE");
     c->add_option("--time", linear_args.time, "hold the inputs at their values at this time [s] (default: the scene's start)");
+    c->add_option("--hold", linear_args.holds, "hold a signal at a value, SIGNAL=VALUE (e.g. rig.zdot=0: the pads still)");
     c->add_option("--format", linear_args.format, "csv: the CSV/JSON files; mat: also a MAT v5 file")
         ->check(CLI::IsMember({"csv", "mat"}))->capture_default_str();
     return c;
@@ -155,6 +156,9 @@ int main(int argc, char** argv) {
     return 2;
   } catch (const dydp::engine::SolverError& e) {
     err << "solver failure: " << e.what() << "\n";
+    return 1;
+  } catch (const dydp::engine::OutOfDomain& e) {
+    err << "solver failure: " << e.reason << "\n";
     return 1;
   } catch (const std::exception& e) {
     err << "error: " << e.what() << "\n";

@@ -137,6 +137,9 @@ void Evaluator::outputs(double t, const double* x) {
     e.inputs_ready = step.inputs_ready;
     call_block(n, [&] { n.block->outputs(e, y_.data()); });
     if (time_only_[i]) source_valid_[i] = true, source_t_[i] = t, source_segment_[i] = segment_start_;
+    for (const auto& [offset, value] : held_values_)
+      for (int k : step.outputs)
+        if (offset >= n.output_offset[k] && offset < n.output_offset[k] + n.block->outputs()[k].width) sig_[offset] = value;
   }
   valid_ = true;
   last_t_ = t;
@@ -202,6 +205,12 @@ void Evaluator::tangents(double t, const double* x, int nd, ConstDirView dx, boo
       if (quads) n.block->quadratures_tangent(e, s, {dqdot.data + n.quad_offset, dqdot.ld});
     });
   }
+}
+
+void Evaluator::hold_signals(std::vector<std::pair<int, double>> values) {
+  held_values_ = std::move(values);
+  valid_ = false;
+  std::fill(source_valid_.begin(), source_valid_.end(), false);
 }
 
 void Evaluator::set_signal_seeds(std::vector<int> offsets, std::vector<double> seeds) {

@@ -45,6 +45,10 @@ class Evaluator {
   /// cut there, the signal a free input: a linearisation's inputs). Every tangents call must
   /// then have the seeds' number of directions. Empty offsets: none (the default).
   void set_signal_seeds(std::vector<int> offsets, std::vector<double> seeds);
+  /// Signals whose values the value pass sets instead of computing them: (offset, value) pairs
+  /// (a pad held still: its rate at 0). Their tangents are the caller's to hold at zero
+  /// (set_signal_seeds). Empty: none (the default).
+  void hold_signals(std::vector<std::pair<int, double>> values);
 
   /// Overwrites the diagonal block d(xdot_b)/dx_b of jac (column-major, leading dimension ld)
   /// for every block that provides Block::local_jacobian, at (t, x). False when none does.
@@ -102,6 +106,7 @@ class Evaluator {
   std::vector<int> local_nodes_;                   ///< their nodes
   double last_t_ = 0.0;
   std::vector<double> last_x_;
+  std::vector<std::pair<int, double>> held_values_;  ///< see hold_signals
   std::vector<int> seeded_;            ///< per signal: its column in signal_seeds_, or -1
   std::vector<double> signal_seeds_;   ///< see set_signal_seeds
   int num_seeded_ = 0;

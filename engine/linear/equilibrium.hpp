@@ -2,8 +2,10 @@
 // state x* where every state derivative vanishes, by damped Newton on xdot(x) = 0 in the
 // states' nominal units, from the scene's initial state; and dx*/dp for the scene's parameters
 // and directions by the implicit function theorem, A dx*/dp = -df/dp (one solve with the
-// diagram's Jacobian for them all). States that no force holds (a free rigid-body coordinate:
-// A singular) keep their initial values: the steps are minimum-norm.
+// diagram's Jacobian for them all). A diagram with conserved quantities (the oil in a damper, a
+// free body's momentum: A singular) has a family of equilibria: the one found keeps them at
+// their initial values, as a run from the initial state would; coordinates that no force holds
+// (a free body's position, a wheel's spin) keep their initial values.
 #pragma once
 
 #include <Eigen/Dense>
@@ -16,8 +18,13 @@ namespace dydp::engine {
 
 struct EquilibriumOptions {
   double time = 0.0;          ///< the inputs are held at their values at this time
+  std::vector<std::pair<int, double>> held;  ///< signals held at other values (held_signals)
   int max_iterations = 60;
   double tolerance = 1e-12;   ///< on the largest Newton step in nominal units
+  /// With conserved quantities: the time [s] and the implicit Euler steps (and twice as many)
+  /// over which the state first moves toward x* (see equilibrium.cpp, settle).
+  double settle_time = 4.0;
+  int settle_steps = 400;
 };
 
 struct Equilibrium {
@@ -29,6 +36,7 @@ struct Equilibrium {
   double residual = 0.0;
   int iterations = 0;
   int rank_deficiency = 0;            ///< states no force holds (A's numerical null space)
+  std::vector<std::pair<int, double>> held;  ///< as the options gave them
   std::vector<int> parameters;        ///< scene parameter indices of the columns of dx_dp
   Eigen::MatrixXd dx_dp;              ///< n x parameters
 };

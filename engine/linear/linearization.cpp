@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "engine/analysis/tolerances.hpp"
 #include "engine/evaluation/evaluator.hpp"
@@ -18,6 +19,25 @@ std::vector<int> differentiable_parameters(const Diagram& d) {
       out.push_back(i);
     } catch (const InputError&) {
     }
+  }
+  return out;
+}
+
+std::vector<std::pair<int, double>> held_signals(const Diagram& d, const std::vector<std::string>& specs,
+                                                 const std::string& field) {
+  std::vector<std::pair<int, double>> out;
+  for (const std::string& spec : specs) {
+    const auto eq = spec.find('=');
+    if (eq == std::string::npos) throw InputError(field, 0, spec, "expected SIGNAL=VALUE");
+    double value = 0.0;
+    try {
+      size_t used = 0;
+      value = std::stod(spec.substr(eq + 1), &used);
+      if (used != spec.size() - eq - 1) throw std::invalid_argument("trailing");
+    } catch (const std::exception&) {
+      throw InputError(field, 0, spec, "the value after '=' is not a number");
+    }
+    for (int o : signal_offsets(d, spec.substr(0, eq), field)) out.push_back({o, value});
   }
   return out;
 }
@@ -41,8 +61,10 @@ struct Ports {
   std::vector<int> outputs;              ///< one offset per output row
 };
 
-Ports resolve(const Diagram& d, const std::vector<std::string>& inputs, std::vector<std::string>& outputs) {
+Ports resolve(const Diagram& d, const std::vector<std::string>& inputs, std::vector<std::string>& outputs,
+              const std::vector<std::pair<int, double>>& held) {
   Ports p;
+  for (const auto& h : held) p.held.push_back(h.first);
   for (const std::string& name : inputs) {
     p.inputs.push_back(signal_offsets(d, name, "--input"));
     for (int o : p.inputs.back()) {
@@ -65,17 +87,21 @@ Ports resolve(const Diagram& d, const std::vector<std::string>& inputs, std::vec
 }  // namespace
 
 LinearModel linearize(const Diagram& d, double t, const std::vector<double>& x,
-                      const std::vector<std::string>& inputs, const std::vector<std::string>& outputs) {
+                      const std::vector<std::string>& inputs, const std::vector<std::string>& outputs,
+                      const std::vector<std::pair<int, double>>& held) {
   LinearModel m;
+  m.held = held;
   m.t = t;
   m.x = x;
   m.inputs = inputs;
   m.outputs = outputs;
-  const Ports ports = resolve(d, inputs, m.outputs);
+  const Ports ports = resolve(d, inputs, m.outputs, held);
+  const int first_input = static_cast<int>(held.size());  // ports.held: the held ones, then the inputs'
   const int n = d.num_states, ni = static_cast<int>(inputs.size()), no = static_cast<int>(ports.outputs.size());
   for (int i = 0; i < n; ++i) m.states.push_back(state_label(d, i));
   Evaluator e(d, false);
   e.set_segment_start(t);
+  e.hold_signals(held);
   // A and C: state seeds, the inputs' wires cut (their tangents held at zero).
   m.A = state_jacobian(e, n, t, x, ports.held);
   m.C.resize(no, n);
@@ -93,7 +119,7 @@ LinearModel linearize(const Diagram& d, double t, const std::vector<double>& x,
   if (ni > 0) {
     const int nh = static_cast<int>(ports.held.size());
     std::vector<double> seeds(static_cast<size_t>(nh) * ni, 0.0);
-    for (int j = 0, h = 0; j < ni; ++j)
+    for (int j = 0, h = first_input; j < ni; ++j)
       for (size_t k = 0; k < ports.inputs[j].size(); ++k, ++h) seeds[static_cast<size_t>(j) * nh + h] = 1.0;
     e.set_signal_seeds(ports.held, seeds);
     e.tangents(t, x.data(), ni, {}, false, {m.B.data(), n}, {});
@@ -105,9 +131,11 @@ LinearModel linearize(const Diagram& d, double t, const std::vector<double>& x,
 }
 
 std::vector<double> signal_values(const Diagram& d, double t, const std::vector<double>& x,
-                                  const std::vector<std::string>& names) {
+                                  const std::vector<std::string>& names,
+                                  const std::vector<std::pair<int, double>>& held) {
   Evaluator e(d, false);
   e.set_segment_start(t);
+  e.hold_signals(held);
   e.outputs(t, x.data());
   std::vector<double> values;
   for (const std::string& name : names)
@@ -128,7 +156,7 @@ LinearModelDerivative linear_model_derivative(Diagram& d, const LinearModel& m, 
     for (size_t i = 0; i < x.size(); ++i) x[i] += sign * h * dx_dp[static_cast<Eigen::Index>(i)];
     d.set_parameter(parameter, p0 + sign * h, false);
     try {
-      at[s] = linearize(d, m.t, x, m.inputs, m.outputs);
+      at[s] = linearize(d, m.t, x, m.inputs, m.outputs, m.held);
     } catch (...) {
       d.set_parameter(parameter, p0, false);
       throw;

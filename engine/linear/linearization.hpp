@@ -21,7 +21,14 @@ struct LinearModel {
   std::vector<std::string> inputs;      ///< as named (a whole port moves all its elements)
   std::vector<std::string> outputs;     ///< one per element: block.port or block.port[i]
   Eigen::MatrixXd A, B, C, D;
+  std::vector<std::pair<int, double>> held;  ///< signals held at a value (offset, value)
 };
+
+/// Signals held at given values, `NAME=VALUE` (a pad's rate at 0, so that a rig whose sine
+/// starts moving at t0 holds its pads still): their wires cut, the value forced. Throws
+/// InputError naming `field`.
+std::vector<std::pair<int, double>> held_signals(const Diagram& d, const std::vector<std::string>& specs,
+                                                 const std::string& field);
 
 /// The scene parameters (and directions) whose derivatives the linear analyses give: all of
 /// them that every block they drive can differentiate, in the scene's order.
@@ -34,11 +41,13 @@ Eigen::MatrixXd state_jacobian(Evaluator& e, int num_states, double t, const std
 /// Linearises about (t, x). inputs, outputs: signal names (signal_lookup.hpp); an empty
 /// outputs list means the scene's logged signals. Throws InputError (field --input/--output).
 LinearModel linearize(const Diagram& d, double t, const std::vector<double>& x,
-                      const std::vector<std::string>& inputs, const std::vector<std::string>& outputs);
+                      const std::vector<std::string>& inputs, const std::vector<std::string>& outputs,
+                      const std::vector<std::pair<int, double>>& held = {});
 
 /// The values of the named signals (signal_lookup.hpp, one per element) at (t, x).
 std::vector<double> signal_values(const Diagram& d, double t, const std::vector<double>& x,
-                                  const std::vector<std::string>& names);
+                                  const std::vector<std::string>& names,
+                                  const std::vector<std::pair<int, double>>& held = {});
 
 /// d(A, B, C, D)/dp for scene parameter `parameter` along the operating point's own path
 /// x(p) = x + dx_dp (p - p0) (the equilibrium's, dx*/dp; zero for a fixed point): a central
@@ -47,7 +56,14 @@ std::vector<double> signal_values(const Diagram& d, double t, const std::vector<
 /// the default step is the one a step study on the sedan and the quarter car shows best.
 struct LinearModelDerivative {
   Eigen::MatrixXd A, B, C, D;
+  std::vector<std::pair<int, double>> held;  ///< signals held at a value (offset, value)
 };
+
+/// Signals held at given values, `NAME=VALUE` (a pad's rate at 0, so that a rig whose sine
+/// starts moving at t0 holds its pads still): their wires cut, the value forced. Throws
+/// InputError naming `field`.
+std::vector<std::pair<int, double>> held_signals(const Diagram& d, const std::vector<std::string>& specs,
+                                                 const std::string& field);
 LinearModelDerivative linear_model_derivative(Diagram& d, const LinearModel& m, int parameter,
                                               const Eigen::VectorXd& dx_dp, double relative_step = 1e-4);
 

@@ -22,14 +22,15 @@ struct Mode {
   std::complex<double> eigenvalue;  ///< the one of a conjugate pair with Im >= 0
   double frequency_hz = 0.0;        ///< |lambda| / (2 pi): the undamped natural frequency
   double damping_ratio = 0.0;       ///< -Re(lambda) / |lambda| (1 for a real, decaying one)
-  /// The states whose share of the shape, |v_i / nominal_i|^2 normalised, is largest: at most
-  /// four, largest first, together at least 80 % or down to 5 %.
+  /// The states that take the largest part in the mode, by participation factor |v_i w_i|
+  /// normalised to a sum of 1: at most four, largest first, together at least 80 % or down to 5 %.
   std::vector<std::pair<std::string, double>> dominant;
   std::vector<ModeSensitivity> sensitivity;  ///< one per parameter given, in their order
 };
 
 /// The modes of A, sorted by frequency, one per conjugate pair. dA: dA/dp per parameter (may be
-/// empty). nominals: the states' nominal magnitudes (to weigh the shapes).
+/// empty). nominals: the states' nominal magnitudes (unused by the participation factors; kept
+/// for the callers' shapes).
 std::vector<Mode> modes(const LinearModel& m, const std::vector<double>& nominals,
                         const std::vector<Eigen::MatrixXd>& dA = {});
 
