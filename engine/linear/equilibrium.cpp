@@ -11,16 +11,19 @@
 namespace dydp::engine {
 namespace {
 
-/// Scaled residual r_i = xdot_i / nominal_i, or false when a block refuses the point.
+/// Scaled residual r_i = xdot_i / nominal_i, or false when a block refuses the point (`why`
+/// then says which and why) or a derivative is not finite.
 bool scaled_residual(Evaluator& e, double t, const std::vector<double>& x, const Eigen::VectorXd& nominal,
-                     Eigen::VectorXd& r) {
+                     Eigen::VectorXd& r, std::string* why = nullptr) {
   std::vector<double> xdot(x.size());
   try {
     e.derivatives(t, x.data(), xdot.data());
-  } catch (const OutOfDomain&) {
+  } catch (const OutOfDomain& refused) {
+    if (why) *why = refused.reason;
     return false;
   }
   r = Eigen::Map<const Eigen::VectorXd>(xdot.data(), static_cast<Eigen::Index>(xdot.size())).cwiseQuotient(nominal);
+  if (!r.allFinite() && why) *why = e.find_nonfinite(xdot.data());
   return r.allFinite();
 }
 
@@ -57,8 +60,9 @@ Newton solve(Evaluator& e, double t, std::vector<double> x, const Eigen::VectorX
   const int n = static_cast<int>(x.size());
   const Eigen::VectorXd z0 = Eigen::Map<const Eigen::VectorXd>(x.data(), n).cwiseQuotient(nominal);
   Newton out;
-  if (!scaled_residual(e, t, x, nominal, out.r))
-    throw SolverError(t, "", "the initial state is outside a block's domain or gives non-finite derivatives");
+  std::string why;
+  if (!scaled_residual(e, t, x, nominal, out.r, &why))
+    throw SolverError(t, "", "the state Newton starts from is refused: " + why);
   const auto merit = [&](const std::vector<double>& at, const Eigen::VectorXd& r) {
     const Eigen::VectorXd z = Eigen::Map<const Eigen::VectorXd>(at.data(), n).cwiseQuotient(nominal);
     return std::hypot(r.norm(), G.cols() ? (G.transpose() * (z - z0)).norm() : 0.0);
@@ -133,7 +137,24 @@ Equilibrium find_equilibrium(Diagram& d, const EquilibriumOptions& options) {
   // equilibrium: oil in a damper, a free body's momentum). If there are any, the state first
   // moves toward x* as the diagram would (settle), which keeps them as a run does; Newton from
   // there holds them at that state's values to second order in the (now small) distance.
+  // Converged: the step fell below the tolerance, or the residual is of rounding size against
+  // the largest rate the Jacobian gives there (both in 1/s).
+  const auto require_converged = [&](const Newton& at, double t) {
+    const double residual = n ? at.r.lpNorm<Eigen::Infinity>() : 0.0;
+    const double rate = n ? scaled_jacobian(e, t, at.x, nominal, held).cwiseAbs().maxCoeff() : 0.0;
+    if (at.step <= options.tolerance || residual <= 1e-10 * rate) return;
+    int worst = 0;
+    if (n) at.r.cwiseAbs().maxCoeff(&worst);
+    std::ostringstream why;
+    why << "no equilibrium in reach: after " << at.iterations << " Newton iterations the state derivatives are still "
+        << residual << " nominal units per second (largest: " << (n ? eq.states[worst] : "") << ")";
+    std::string block;
+    for (const Node& node : d.nodes)
+      if (worst >= node.state_offset && worst < node.state_offset + node.block->num_states()) block = node.name;
+    throw SolverError(t, block, why.str());
+  };
   Newton sol = solve(e, eq.t, x0, nominal, Eigen::MatrixXd(n, 0), options, held);
+  require_converged(sol, eq.t);
   Eigen::MatrixXd G = left_null_space(scaled_jacobian(e, eq.t, sol.x, nominal, held));
   // The parameters' evaluator (f_p, the initial state's tangent) and dz0/dp.
   eq.parameters = differentiable_parameters(d);
@@ -159,6 +180,8 @@ Equilibrium find_equilibrium(Diagram& d, const EquilibriumOptions& options) {
     const std::vector<double> fine = settle(e, eq.t, x0, nominal, T / (2 * N), 2 * N, held);
     std::vector<double> start(n);
     for (int i = 0; i < n; ++i) start[i] = 2 * fine[i] - coarse[i];
+    Eigen::VectorXd r;
+    if (!scaled_residual(e, eq.t, start, nominal, r)) start = fine;  // extrapolated out of a domain
     for (int round = 0; round < 2; ++round) {
       sol = solve(e, eq.t, start, nominal, G, options, held);
       G = left_null_space(scaled_jacobian(e, eq.t, sol.x, nominal, held));
@@ -174,18 +197,8 @@ Equilibrium find_equilibrium(Diagram& d, const EquilibriumOptions& options) {
   eq.iterations = sol.iterations;
   eq.residual = n ? sol.r.lpNorm<Eigen::Infinity>() : 0.0;
   eq.rank_deficiency = static_cast<int>(G.cols());
-  // Converged: the step fell below the tolerance, or the residual is of rounding size against
-  // the largest rate the Jacobian gives at x* (both in 1/s).
   const Eigen::MatrixXd As = scaled_jacobian(e, eq.t, eq.x, nominal, held);
-  const double rate = n ? As.cwiseAbs().maxCoeff() : 0.0;
-  if (sol.step > options.tolerance && !(eq.residual <= 1e-10 * rate)) {
-    int worst = 0;
-    if (n) sol.r.cwiseAbs().maxCoeff(&worst);
-    std::ostringstream why;
-    why << "no equilibrium in reach: after " << eq.iterations << " Newton iterations the state derivatives are still "
-        << eq.residual << " nominal units per second (largest: " << (n ? eq.states[worst] : "") << ")";
-    throw SolverError(eq.t, n ? eq.states[worst].substr(0, eq.states[worst].rfind('.')) : "", why.str());
-  }
+  require_converged(sol, eq.t);
   // dx*/dp: As dz = -f_p with the conserved quantities' linearisation at x* held at the
   // initial state's, G^T dz = G^T dz0/dp. Exact where p does not change how a conserved quantity
   // reads the states; where it does (a mount point changes a damper's stroke, hence the oil its

@@ -59,20 +59,29 @@ struct Ports {
   std::vector<std::vector<int>> inputs;  ///< per input: the offsets it moves
   std::vector<int> held;                 ///< all of them
   std::vector<int> outputs;              ///< one offset per output row
+  size_t num_inputs_held = 0;            ///< the inputs' offsets at the end of `held`
 };
 
 Ports resolve(const Diagram& d, const std::vector<std::string>& inputs, std::vector<std::string>& outputs,
               const std::vector<std::pair<int, double>>& held) {
   Ports p;
-  for (const auto& h : held) p.held.push_back(h.first);
+  // A held signal that is also an input keeps its held value as the operating point; its
+  // tangent is the input's.
+  std::vector<int> inputs_offsets;
+  for (const std::string& name : inputs)
+    for (int o : signal_offsets(d, name, "--input")) inputs_offsets.push_back(o);
+  for (const auto& h : held)
+    if (std::find(inputs_offsets.begin(), inputs_offsets.end(), h.first) == inputs_offsets.end()) p.held.push_back(h.first);
+  const size_t held_only = p.held.size();
   for (const std::string& name : inputs) {
     p.inputs.push_back(signal_offsets(d, name, "--input"));
     for (int o : p.inputs.back()) {
-      if (std::find(p.held.begin(), p.held.end(), o) != p.held.end())
+      if (std::find(p.held.begin() + static_cast<long>(held_only), p.held.end(), o) != p.held.end())
         throw InputError("--input", 0, name, "names a signal another input already names");
       p.held.push_back(o);
     }
   }
+  p.num_inputs_held = p.held.size() - held_only;
   std::vector<std::string> rows;
   if (outputs.empty()) {
     for (const LoggedSignal& s : d.logged) p.outputs.push_back(s.offset), rows.push_back(s.name);
@@ -96,7 +105,7 @@ LinearModel linearize(const Diagram& d, double t, const std::vector<double>& x,
   m.inputs = inputs;
   m.outputs = outputs;
   const Ports ports = resolve(d, inputs, m.outputs, held);
-  const int first_input = static_cast<int>(held.size());  // ports.held: the held ones, then the inputs'
+  const int first_input = static_cast<int>(ports.held.size() - ports.num_inputs_held);  // held ones, then the inputs'
   const int n = d.num_states, ni = static_cast<int>(inputs.size()), no = static_cast<int>(ports.outputs.size());
   for (int i = 0; i < n; ++i) m.states.push_back(state_label(d, i));
   Evaluator e(d, false);
