@@ -144,7 +144,8 @@ int equilibrium_command(const LinearArgs& args) {
   }
   std::cout << d.scene_name << ": equilibrium at t = " << eq.t << " s after " << eq.iterations
             << " Newton iterations, residual " << std::setprecision(3) << eq.residual << " nominal units/s";
-  if (eq.rank_deficiency) std::cout << " (" << eq.rank_deficiency << " states held by no force keep their initial values)";
+  if (eq.rank_deficiency)
+    std::cout << " (" << eq.rank_deficiency << " conserved quantities or free coordinates: kept where a run from the initial state leaves them)";
   std::cout << "\n";
   for (size_t k = 0; k < values.size(); ++k) {
     const std::string unit = d.signal_unit(engine::signal_offsets(d, logged.outputs[k], "")[0]);

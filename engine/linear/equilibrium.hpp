@@ -5,7 +5,7 @@
 // diagram's Jacobian for them all). A diagram with conserved quantities (the oil in a damper, a
 // free body's momentum: A singular) has a family of equilibria: the one found keeps them at
 // their initial values, as a run from the initial state would; coordinates that no force holds
-// (a free body's position, a wheel's spin) keep their initial values.
+// (a free body's position, a wheel's spin) stay where the settling motion leaves them.
 #pragma once
 
 #include <Eigen/Dense>
@@ -35,7 +35,7 @@ struct Equilibrium {
   /// max_i |xdot_i(x*)| / nominal_i [1/s]: what is left of the state derivatives.
   double residual = 0.0;
   int iterations = 0;
-  int rank_deficiency = 0;            ///< states no force holds (A's numerical null space)
+  int rank_deficiency = 0;            ///< conserved quantities and free coordinates (A's left null space)
   std::vector<std::pair<int, double>> held;  ///< as the options gave them
   std::vector<int> parameters;        ///< scene parameter indices of the columns of dx_dp
   Eigen::MatrixXd dx_dp;              ///< n x parameters
