@@ -106,6 +106,10 @@ void print_warnings(const std::vector<std::string>& warnings);
 /// "  step limited by: car.qd.z 41 %, damper_fl.q_valve 12 %, ..." (nothing for fixed-step runs).
 void print_limiting_states(std::ostream& out, const engine::RunStats& stats);
 
+/// "LO:HI:N" as three numbers (sweep --range, frf --frequencies); false when it is not that
+/// shape. The callers check the values against their own rules.
+bool split_range(const std::string& text, double& lo, double& hi, double& n);
+
 /// Splits NAME=VALUE pairs; throws InputError naming --set on a malformed one.
 std::vector<std::pair<std::string, std::string>> parse_sets(const std::vector<std::string>& sets);
 

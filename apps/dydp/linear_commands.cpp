@@ -12,7 +12,6 @@
 #include "apps/dydp/commands.hpp"
 #include "apps/dydp/gnuplot.hpp"
 #include "engine/analysis/run.hpp"
-#include "engine/analysis/tolerances.hpp"
 #include "engine/framework/errors.hpp"
 #include "engine/linear/equilibrium.hpp"
 #include "engine/linear/frequency_response.hpp"
@@ -106,7 +105,8 @@ int equilibrium_command(const LinearArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   engine::Diagram d = load(args);
   const engine::Equilibrium eq = engine::find_equilibrium(d, equilibrium_options(d, args));
-  const engine::LinearModel logged = engine::linearize(d, eq.t, eq.x, {}, {}, eq.held);
+  std::vector<std::string> logged;
+  for (const engine::LoggedSignal& l : d.logged) logged.push_back(l.name);
   Json j;
   j["scene"] = d.scene_name;
   j["time"] = eq.t;
@@ -125,8 +125,8 @@ int equilibrium_command(const LinearArgs& args) {
   j["state"] = state;
   j["moved_from_initial"] = moved;
   Json signals = Json::object();
-  const std::vector<double> values = engine::signal_values(d, eq.t, eq.x, logged.outputs, eq.held);
-  for (size_t k = 0; k < values.size(); ++k) signals[logged.outputs[k]] = values[k];
+  const std::vector<double> values = engine::signal_values(d, eq.t, eq.x, logged, eq.held);
+  for (size_t k = 0; k < values.size(); ++k) signals[logged[k]] = values[k];
   j["signals"] = signals;
   Json sens = Json::object();
   for (size_t c = 0; c < eq.parameters.size(); ++c) {
@@ -148,8 +148,8 @@ int equilibrium_command(const LinearArgs& args) {
     std::cout << " (" << eq.rank_deficiency << " conserved quantities or free coordinates: kept where a run from the initial state leaves them)";
   std::cout << "\n";
   for (size_t k = 0; k < values.size(); ++k) {
-    const std::string unit = d.signal_unit(engine::signal_offsets(d, logged.outputs[k], "")[0]);
-    std::cout << "  " << std::left << std::setw(32) << logged.outputs[k] << std::right << std::setw(14)
+    const std::string unit = d.signal_unit(d.logged[k].offset);
+    std::cout << "  " << std::left << std::setw(32) << logged[k] << std::right << std::setw(14)
               << std::setprecision(6) << values[k] << " " << unit << "\n";
   }
   print_done("equilibrium and dx*/dp for " + std::to_string(eq.parameters.size()) + " parameters", seconds_since(start),
@@ -225,7 +225,7 @@ int modes_command(const LinearArgs& args) {
   Point p = linearize_at_equilibrium(d, a, true);
   std::vector<Eigen::MatrixXd> dA;
   for (const auto& dm : p.derivatives) dA.push_back(dm.A);
-  const std::vector<engine::Mode> modes = engine::modes(p.model, engine::state_nominals(d), dA);
+  const std::vector<engine::Mode> modes = engine::modes(p.model, dA);
   const std::vector<std::string> names = parameter_names(d, p.eq.parameters);
   Json list = Json::array();
   for (const engine::Mode& m : modes) {
@@ -307,14 +307,10 @@ int frf_command(const LinearArgs& args) {
   const auto colon = spec.find(':');
   a.inputs = {spec.substr(0, colon)};
   if (colon != std::string::npos) a.inputs.push_back(spec.substr(colon + 1));
-  double lo = 0.5, hi = 30.0;
-  int count = 60;
-  {
-    std::istringstream r(args.frequencies);
-    char c1 = 0, c2 = 0;
-    if (!(r >> lo >> c1 >> hi >> c2 >> count) || c1 != ':' || c2 != ':' || !(lo > 0) || !(hi > lo) || count < 2)
-      throw engine::InputError("--frequencies", 0, args.frequencies, "expected LO:HI:N with 0 < LO < HI, N >= 2 [Hz]");
-  }
+  double lo = 0.0, hi = 0.0, points = 0.0;
+  if (!split_range(args.frequencies, lo, hi, points) || !(lo > 0) || !(hi > lo) || points < 2 || points != std::floor(points))
+    throw engine::InputError("--frequencies", 0, args.frequencies, "expected LO:HI:N with 0 < LO < HI, N >= 2 [Hz]");
+  const int count = static_cast<int>(points);
   const Point p = linearize_at_equilibrium(d, a, true);
   const std::vector<std::string> names = parameter_names(d, p.eq.parameters);
   const engine::FrequencyResponse h = engine::frequency_response(

@@ -5,12 +5,14 @@
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 
 #include "apps/dydp/commands.hpp"
 #include "apps/dydp/report.hpp"
 #include "engine/analysis/error_estimate.hpp"
 #include "engine/analysis/run.hpp"
 #include "engine/framework/errors.hpp"
+#include "engine/framework/numbers.hpp"
 #include "io/mat_outputs.hpp"
 #include "io/output_writer.hpp"
 
@@ -53,6 +55,13 @@ void print_run_warnings(const engine::Diagram& d, const engine::RunResult& r) {
 
 void print_warnings(const std::vector<std::string>& warnings) {
   for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
+}
+
+bool split_range(const std::string& text, double& lo, double& hi, double& n) {
+  std::stringstream ss(text);
+  std::string a, b, c;
+  return std::getline(ss, a, ':') && std::getline(ss, b, ':') && std::getline(ss, c) && engine::parse_number(a, lo) &&
+         engine::parse_number(b, hi) && engine::parse_number(c, n);
 }
 
 int run_command(const RunArgs& args) {

@@ -20,16 +20,12 @@ constexpr int kMaxSweepPoints = 1000000;
 
 /// "LO:HI:N" -> low, high, points.
 void parse_range(const std::string& text, engine::SweepSpec& spec) {
-  std::stringstream ss(text);
-  std::string lo, hi, n;
   double points = 0;
-  if (!std::getline(ss, lo, ':') || !std::getline(ss, hi, ':') || !std::getline(ss, n) ||
-      !engine::parse_number(lo, spec.low) || !engine::parse_number(hi, spec.high) ||
-      !engine::parse_number(n, points) || points < 1 || points != std::floor(points) || spec.high < spec.low)
+  if (!split_range(text, spec.low, spec.high, points) || points < 1 || points != std::floor(points) || spec.high < spec.low)
     throw engine::InputError("--range", 0, text, "expected LO:HI:N with LO <= HI and N >= 1");
   // One point spans no range: LO:HI:1 with LO < HI would sweep nothing but LO.
   if (points > kMaxSweepPoints)
-    throw engine::InputError("--range", 0, text, "N = " + n + " is more than " + std::to_string(kMaxSweepPoints) + " runs");
+    throw engine::InputError("--range", 0, text, "N = " + text.substr(text.rfind(':') + 1) + " is more than " + std::to_string(kMaxSweepPoints) + " runs");
   if (points == 1 && spec.low < spec.high)
     throw engine::InputError("--range", 0, text, "N = 1 with LO < HI sweeps one point: give N >= 2, or LO = HI");
   spec.points = static_cast<int>(points);

@@ -133,15 +133,11 @@ Equilibrium find_equilibrium(Diagram& d, const EquilibriumOptions& options) {
   std::vector<double> x0(n);
   e.initial_state(d.time.start, x0.data());
   eq.initial = x0;
-  // A first solution finds the conserved quantities (the left null space of the Jacobian at an
-  // equilibrium: oil in a damper, a free body's momentum). If there are any, the state first
-  // moves toward x* as the diagram would (settle), which keeps them as a run does; Newton from
-  // there holds them at that state's values to second order in the (now small) distance.
   // Converged: the step fell below the tolerance, or the residual is of rounding size against
-  // the largest rate the Jacobian gives there (both in 1/s).
-  const auto require_converged = [&](const Newton& at, double t) {
+  // the largest rate the (scaled) Jacobian gives there (both in 1/s).
+  const auto require_converged = [&](const Newton& at, const Eigen::MatrixXd& jacobian) {
     const double residual = n ? at.r.lpNorm<Eigen::Infinity>() : 0.0;
-    const double rate = n ? scaled_jacobian(e, t, at.x, nominal, held).cwiseAbs().maxCoeff() : 0.0;
+    const double rate = n ? jacobian.cwiseAbs().maxCoeff() : 0.0;
     if (at.step <= options.tolerance || residual <= 1e-10 * rate) return;
     int worst = 0;
     if (n) at.r.cwiseAbs().maxCoeff(&worst);
@@ -151,15 +147,25 @@ Equilibrium find_equilibrium(Diagram& d, const EquilibriumOptions& options) {
     std::string block;
     for (const Node& node : d.nodes)
       if (worst >= node.state_offset && worst < node.state_offset + node.block->num_states()) block = node.name;
-    throw SolverError(t, block, why.str());
+    throw SolverError(eq.t, block, why.str());
   };
+  // A first solution finds the conserved quantities (the left null space of the Jacobian at an
+  // equilibrium: oil in a damper, a free body's momentum). If there are any, the state first
+  // moves toward x* as the diagram would (settle), which keeps them as a run does; Newton from
+  // there holds them at that state's values to second order in the (now small) distance.
   Newton sol = solve(e, eq.t, x0, nominal, Eigen::MatrixXd(n, 0), options, held);
-  require_converged(sol, eq.t);
-  Eigen::MatrixXd G = left_null_space(scaled_jacobian(e, eq.t, sol.x, nominal, held));
+  Eigen::MatrixXd As = scaled_jacobian(e, eq.t, sol.x, nominal, held);
+  require_converged(sol, As);
+  Eigen::MatrixXd G = left_null_space(As);
   // The parameters' evaluator (f_p, the initial state's tangent) and dz0/dp.
   eq.parameters = differentiable_parameters(d);
   const int np = static_cast<int>(eq.parameters.size());
-  const std::vector<int> saved = d.sensitivities;
+  // The diagram's directions are the parameters' while ep lives; given back on every exit.
+  struct RestoreSensitivities {
+    Diagram& d;
+    std::vector<int> saved;
+    ~RestoreSensitivities() { d.set_sensitivities(saved); }
+  } restore{d, d.sensitivities};
   d.set_sensitivities(eq.parameters);
   Evaluator ep(d, true);
   ep.set_segment_start(eq.t);
@@ -192,13 +198,13 @@ Equilibrium find_equilibrium(Diagram& d, const EquilibriumOptions& options) {
     const int iterations = sol.iterations;
     sol = solve(e, eq.t, sol.x, nominal, Eigen::MatrixXd(n, 0), options, held);
     sol.iterations += iterations;
+    As = scaled_jacobian(e, eq.t, sol.x, nominal, held);
+    require_converged(sol, As);
   }
   eq.x = sol.x;
   eq.iterations = sol.iterations;
   eq.residual = n ? sol.r.lpNorm<Eigen::Infinity>() : 0.0;
   eq.rank_deficiency = static_cast<int>(G.cols());
-  const Eigen::MatrixXd As = scaled_jacobian(e, eq.t, eq.x, nominal, held);
-  require_converged(sol, eq.t);
   // dx*/dp: As dz = -f_p with the conserved quantities' linearisation at x* held at the
   // initial state's, G^T dz = G^T dz0/dp. Exact where p does not change how a conserved quantity
   // reads the states; where it does (a mount point changes a damper's stroke, hence the oil its
@@ -218,7 +224,6 @@ Equilibrium find_equilibrium(Diagram& d, const EquilibriumOptions& options) {
     ls.compute(M);
     eq.dx_dp = nominal.asDiagonal() * ls.solve(rhs);
   }
-  d.set_sensitivities(saved);
   return eq;
 }
 

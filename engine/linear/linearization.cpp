@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
 #include "engine/analysis/tolerances.hpp"
 #include "engine/evaluation/evaluator.hpp"
 #include "engine/framework/errors.hpp"
+#include "engine/framework/numbers.hpp"
 #include "engine/linear/signal_lookup.hpp"
 
 namespace dydp::engine {
@@ -30,13 +30,7 @@ std::vector<std::pair<int, double>> held_signals(const Diagram& d, const std::ve
     const auto eq = spec.find('=');
     if (eq == std::string::npos) throw InputError(field, 0, spec, "expected SIGNAL=VALUE");
     double value = 0.0;
-    try {
-      size_t used = 0;
-      value = std::stod(spec.substr(eq + 1), &used);
-      if (used != spec.size() - eq - 1) throw std::invalid_argument("trailing");
-    } catch (const std::exception&) {
-      throw InputError(field, 0, spec, "the value after '=' is not a number");
-    }
+    if (!parse_number(spec.substr(eq + 1), value)) throw InputError(field, 0, spec, "the value after '=' is not a number");
     for (int o : signal_offsets(d, spec.substr(0, eq), field)) out.push_back({o, value});
   }
   return out;
@@ -65,22 +59,23 @@ struct Ports {
 Ports resolve(const Diagram& d, const std::vector<std::string>& inputs, std::vector<std::string>& outputs,
               const std::vector<std::pair<int, double>>& held) {
   Ports p;
+  for (const std::string& name : inputs) p.inputs.push_back(signal_offsets(d, name, "--input"));
   // A held signal that is also an input keeps its held value as the operating point; its
   // tangent is the input's.
-  std::vector<int> inputs_offsets;
-  for (const std::string& name : inputs)
-    for (int o : signal_offsets(d, name, "--input")) inputs_offsets.push_back(o);
+  const auto is_input = [&](int offset) {
+    for (const auto& in : p.inputs)
+      if (std::find(in.begin(), in.end(), offset) != in.end()) return true;
+    return false;
+  };
   for (const auto& h : held)
-    if (std::find(inputs_offsets.begin(), inputs_offsets.end(), h.first) == inputs_offsets.end()) p.held.push_back(h.first);
+    if (!is_input(h.first)) p.held.push_back(h.first);
   const size_t held_only = p.held.size();
-  for (const std::string& name : inputs) {
-    p.inputs.push_back(signal_offsets(d, name, "--input"));
-    for (int o : p.inputs.back()) {
+  for (size_t j = 0; j < inputs.size(); ++j)
+    for (int o : p.inputs[j]) {
       if (std::find(p.held.begin() + static_cast<long>(held_only), p.held.end(), o) != p.held.end())
-        throw InputError("--input", 0, name, "names a signal another input already names");
+        throw InputError("--input", 0, inputs[j], "names a signal another input already names");
       p.held.push_back(o);
     }
-  }
   p.num_inputs_held = p.held.size() - held_only;
   std::vector<std::string> rows;
   if (outputs.empty()) {
@@ -111,14 +106,13 @@ LinearModel linearize(const Diagram& d, double t, const std::vector<double>& x,
   Evaluator e(d, false);
   e.set_segment_start(t);
   e.hold_signals(held);
-  // A and C: state seeds, the inputs' wires cut (their tangents held at zero).
-  m.A = state_jacobian(e, n, t, x, ports.held);
+  // A and C from one pass: state seeds, the inputs' wires cut (their tangents held at zero).
+  m.A.resize(n, n);
   m.C.resize(no, n);
   if (n > 0) {
     const Eigen::MatrixXd seeds = Eigen::MatrixXd::Identity(n, n);
-    Eigen::MatrixXd dxdot(n, n);
     e.set_signal_seeds(ports.held, std::vector<double>(ports.held.size() * n, 0.0));
-    e.tangents(t, x.data(), n, {seeds.data(), n}, false, {dxdot.data(), n}, {});
+    e.tangents(t, x.data(), n, {seeds.data(), n}, false, {m.A.data(), n}, {});
     for (int r = 0; r < no; ++r)
       for (int c = 0; c < n; ++c) m.C(r, c) = e.signal_tangents()[static_cast<size_t>(c) * d.num_signals + ports.outputs[r]];
   }

@@ -45,8 +45,7 @@ Eigen::VectorXd balance(const Eigen::MatrixXd& A) {
 
 }  // namespace
 
-std::vector<Mode> modes(const LinearModel& m, const std::vector<double>& nominals,
-                        const std::vector<Eigen::MatrixXd>& dA) {
+std::vector<Mode> modes(const LinearModel& m, const std::vector<Eigen::MatrixXd>& dA) {
   const Eigen::Index n = m.A.rows();
   std::vector<Mode> out;
   if (n == 0) return out;

@@ -29,9 +29,7 @@ struct Mode {
 };
 
 /// The modes of A, sorted by frequency, one per conjugate pair. dA: dA/dp per parameter (may be
-/// empty). nominals: the states' nominal magnitudes (unused by the participation factors; kept
-/// for the callers' shapes).
-std::vector<Mode> modes(const LinearModel& m, const std::vector<double>& nominals,
-                        const std::vector<Eigen::MatrixXd>& dA = {});
+/// empty).
+std::vector<Mode> modes(const LinearModel& m, const std::vector<Eigen::MatrixXd>& dA = {});
 
 }  // namespace dydp::engine

@@ -10,7 +10,6 @@
 #include <filesystem>
 #include <fstream>
 
-#include "engine/analysis/tolerances.hpp"
 #include "engine/framework/errors.hpp"
 #include "engine/linear/equilibrium.hpp"
 #include "engine/linear/frequency_response.hpp"
@@ -144,7 +143,7 @@ TEST_F(QuarterCarLinear, EquilibriumCarriesTheWeightOnSpringAndTyre) {
 
 TEST_F(QuarterCarLinear, ModesAreTheClosedFormsTwo) {
   const LinearModel m = linearize(d_, eq_.t, eq_.x, {}, {});
-  const std::vector<Mode> found = modes(m, state_nominals(d_));
+  const std::vector<Mode> found = modes(m);
   const std::vector<Complex> expected = closed_form_modes(Values{});
   ASSERT_EQ(found.size(), 2u);
   for (int k = 0; k < 2; ++k) {
@@ -168,7 +167,7 @@ TEST_F(QuarterCarLinear, EigenvalueDerivativesAreTheClosedFormsDerivatives) {
     ASSERT_NE(it, eq_.parameters.end()) << p;
     dA.push_back(linear_model_derivative(d_, m, parameter(p), eq_.dx_dp.col(it - eq_.parameters.begin())).A);
   }
-  const std::vector<Mode> found = modes(m, state_nominals(d_), dA);
+  const std::vector<Mode> found = modes(m, dA);
   ASSERT_EQ(found.size(), 2u);
   for (size_t j = 0; j < names.size(); ++j) {
     // The closed form's eigenvalues differenced at +-1e-4 relative (their error ~1e-9 relative).

@@ -15,7 +15,6 @@
 #include <algorithm>
 
 #include "engine/analysis/run.hpp"
-#include "engine/analysis/tolerances.hpp"
 #include "engine/linear/equilibrium.hpp"
 #include "engine/linear/frequency_response.hpp"
 #include "engine/linear/modes.hpp"
@@ -54,17 +53,22 @@ Diagram sedan(double amplitude = 0.0, double frequency = 1.0) {
   return d;
 }
 
+/// A run of d to `stop` without sensitivities, BDF at rtol, atol.
+RunResult plain_run(Diagram& d, double stop, double rtol, double atol) {
+  d.time.stop = stop;
+  d.solver.rtol = rtol;
+  d.solver.atol = atol;
+  RunOptions o;
+  o.sensitivities = false;
+  return run(d, o);
+}
+
 TEST(SedanLinear, EquilibriumIsWhereALongRunSettles) {
   Diagram d = sedan();
   const Equilibrium eq = find_equilibrium(d);
-  d.time.stop = 60.0;
-  d.solver.rtol = 1e-12;
-  d.solver.atol = 1e-10;
-  RunOptions o;
-  o.sensitivities = false;
-  const RunResult r = run(d, o);
-  // The coordinates no force holds (the body's x, y and yaw, the wheels' spins) drift in the
-  // run as it settles and keep their initial values in the equilibrium: not compared.
+  const RunResult r = plain_run(d, 60.0, 1e-12, 1e-10);
+  // The coordinates no force holds (the body's x, y and yaw, the wheels' spins) drift as the
+  // car settles, in the run for 60 s and in the equilibrium's settling motion for 4: not compared.
   const auto free = [](const std::string& s) {
     for (const char* f : {"car.q.x", "car.q.y", "car.q.yaw", "car.q.spin_", "car.qd.x", "car.qd.y", "car.qd.yaw", "car.qd.spin_"})
       if (s.rfind(f, 0) == 0) return true;
@@ -99,12 +103,7 @@ std::complex<double> simulated_response(double frequency) {
   std::vector<double> y[2];
   for (int k = 0; k < 2; ++k) {
     Diagram d = sedan(k == 0 ? amplitude : 0.0, frequency);
-    d.time.stop = 8.0;
-    d.solver.rtol = 1e-9;
-    d.solver.atol = 1e-9;
-    RunOptions o;
-    o.sensitivities = false;
-    const RunResult r = run(d, o);
+    const RunResult r = plain_run(d, 8.0, 1e-9, 1e-9);
     const int i = r.signal_index("car.body_acc_z");
     EXPECT_GE(i, 0);
     for (size_t j = 0; j < r.t.size(); ++j)
@@ -140,7 +139,7 @@ std::vector<std::complex<double>> eigenvalues_at(Diagram& d, int parameter, doub
   const double saved = d.parameters[parameter].value;
   d.set_parameter(parameter, value, false);
   const Equilibrium eq = find_equilibrium(d);
-  const std::vector<Mode> found = modes(linearize(d, eq.t, eq.x, {}, {}), state_nominals(d));
+  const std::vector<Mode> found = modes(linearize(d, eq.t, eq.x, {}, {}));
   d.set_parameter(parameter, saved, false);
   std::vector<std::complex<double>> out;
   for (std::complex<double> l : nominal) {
@@ -167,7 +166,7 @@ void check_eigenvalue_derivatives(const std::vector<std::string>& names, double 
     ASSERT_NE(it, eq.parameters.end()) << p;
     dA.push_back(linear_model_derivative(d, m, index.back(), eq.dx_dp.col(it - eq.parameters.begin())).A);
   }
-  const std::vector<Mode> all = modes(m, state_nominals(d), dA);
+  const std::vector<Mode> all = modes(m, dA);
   // The body's three modes (1-2 Hz) and the four wheel hops (10-20 Hz).
   std::vector<const Mode*> checked;
   for (const Mode& mode : all)
