@@ -33,10 +33,10 @@ using engine::RunResult;
 // (docs/testing.md).
 constexpr double kRtol = 1e-12, kAtol = 1e-12;
 
-// The first step moves the most sensitive quantity by about this fraction of its magnitude (by
-// the exact sensitivity), at most kLargestStep of |p|; the study halves it until every column
-// is in its h^2 regime.
-constexpr double kFirstChange = 1e-3;
+// The first step h moves the most sensitive quantity by about this fraction of its magnitude
+// (by the exact sensitivity), at most kLargestStep of |p|; the study halves it until every
+// column is in its h^2 regime.
+constexpr double kFirstChange = 4e-3;
 constexpr double kLargestStep = 2e-2;
 constexpr int kMaxHalvings = 8;
 
@@ -45,13 +45,13 @@ constexpr int kMaxHalvings = 8;
 // that scale times kNegligible.
 constexpr double kNegligible = 1e-3;
 
-// The h^2 regime: the difference between the quotients at 2h and 4h is 4 times that between h
-// and 2h, to within kRatioSlack; or both differences are below kResolved (the quotients agree
+// The h^2 regime: D2 = q(4h) - q(2h) is 4 times D1 = q(2h) - q(h) (largest over the grid), to
+// within kRatioSlack; or both differences are below kResolved (the quotients agree
 // at every step: no h^2 term to see above the runs' own error, which the same bound covers).
 constexpr double kRatioSlack = 1.0, kResolved = 2e-6;
 
 // The sensitivity must match the finer quotient with its h^2 term removed to within the study's
-// misfit (|D(4h) - 4 D(2h)|, which bounds the removed term's h^4 remainder 45-fold and the runs'
+// misfit (max |D2 - 4 D1|, which bounds the removed term's h^4 remainder 45-fold and the runs'
 // noise in it about 4-fold), but never tighter than kResolved; a study whose misfit is above
 // kWorst does not resolve what the test is for and fails.
 constexpr double kWorst = 1e-4;
@@ -104,7 +104,7 @@ struct ColumnCheck {
   std::string parameter, quantity;
   double scale = 0;         ///< what the figures are relative to
   double d1 = 0, d2 = 0;    ///< max |q(2h) - q(h)|, max |q(4h) - q(2h)|
-  double misfit = 0;        ///< max |D(4h) - 4 D(2h)|, D(x) = q(x) - q(x/2)
+  double misfit = 0;        ///< max |D2 - 4 D1|
   double fine = 0;          ///< max |sens - q(h)|
   double error = 0;         ///< max |sens - (q(h) + (q(h) - q(2h)) / 3)|
   double tolerance = 0;
@@ -204,15 +204,14 @@ class SensitivityMatrix : public DydpProcessTest {
     std::vector<ColumnCheck> checked;
     for (size_t p = 0; p < all.size(); p += every) {
       const engine::SceneParameter& parameter = d.parameters[p];
-      // First step: the most sensitive quantity moves by 4 kFirstChange of its magnitude (the
-      // first halving brings it to kFirstChange), at most kLargestStep of |p|, and p +- 4h
-      // inside the scene's range where it declares one.
+      // First step: the most sensitive quantity moves by kFirstChange of its magnitude, at most
+      // kLargestStep of |p|, and p +- 4h inside the scene's range where it declares one.
       double relative_change = 0;
       for (size_t i = 0; i < base.names.size(); ++i)
         if (largest(base.columns[i]) > 0)
           relative_change = std::max(relative_change, magnitude[p] * largest(sens[p][i]) / largest(base.columns[i]));
       ASSERT_GT(relative_change, 0) << parameter.name << " moves nothing";
-      double h = std::min(4 * kFirstChange / relative_change, kLargestStep) * magnitude[p];
+      double h = std::min(kFirstChange / relative_change, kLargestStep) * magnitude[p];
       h = std::min({h, (parameter.value - parameter.lower) / 4, (parameter.upper - parameter.value) / 4});
       // q[0], q[1], q[2]: the quotients at h, 2h, 4h; each halving reuses two of them.
       std::vector<std::vector<std::vector<double>>> q = {central_difference(scene, p, h),
