@@ -99,28 +99,27 @@ TEST_P(StressReference, ShippedSettingsMatchAConvergedSdirk2Reference) {
   // Scales: an objective's own magnitude; for its sensitivities the largest |p| dpsi/dp (in
   // units of psi), divided by |p| of each; a signal's largest magnitude over the fine run.
   std::vector<Pin> pins;
-  size_t next = 0;
+  size_t next = 0;  // pinned() lists objectives, their sensitivities, then signals by time
+  const auto add = [&](double scale, double target) {
+    pins.push_back({values[next].first, values[next].second, at_coarse[next].second, at_fine[next].second, scale, target});
+    ++next;
+  };
   for (const auto& o : fine.objectives) {
-    Pin value{values[next].first, values[next].second, at_coarse[next].second, at_fine[next].second,
-              std::fabs(o.value), kObjectiveTarget};
-    pins.push_back(value), ++next;
+    add(std::fabs(o.value), kObjectiveTarget);
+    std::vector<double> magnitude(o.sensitivity.size());
     double largest = 0;
-    for (size_t d = 0; d < o.sensitivity.size(); ++d)
-      largest = std::max(largest, std::fabs(shipped_scene.parameters[shipped_scene.sensitivities[d]].value *
-                                            o.sensitivity[d]));
-    for (size_t d = 0; d < o.sensitivity.size(); ++d, ++next) {
-      const double p = std::fabs(shipped_scene.parameters[shipped_scene.sensitivities[d]].value);
-      pins.push_back({values[next].first, values[next].second, at_coarse[next].second, at_fine[next].second,
-                      largest / p, kSensitivityTarget});
+    for (size_t d = 0; d < o.sensitivity.size(); ++d) {
+      magnitude[d] = std::fabs(shipped_scene.parameters[shipped_scene.sensitivities[d]].value);
+      largest = std::max(largest, magnitude[d] * std::fabs(o.sensitivity[d]));
     }
+    for (size_t d = 0; d < o.sensitivity.size(); ++d) add(largest / magnitude[d], kSensitivityTarget);
   }
+  std::vector<double> signal_scale(fine.num_signals(), 0.0);
+  for (int i = 0; i < fine.num_signals(); ++i)
+    for (size_t k = 0; k < fine.t.size(); ++k)
+      signal_scale[i] = std::max(signal_scale[i], std::fabs(fine.value(static_cast<int>(k), i)));
   for (size_t t = 0; t < kTimes.size(); ++t)
-    for (int i = 0; i < fine.num_signals(); ++i, ++next) {
-      double largest = 0;
-      for (size_t k = 0; k < fine.t.size(); ++k) largest = std::max(largest, std::fabs(fine.value(static_cast<int>(k), i)));
-      pins.push_back({values[next].first, values[next].second, at_coarse[next].second, at_fine[next].second, largest,
-                      kSignalTarget});
-    }
+    for (int i = 0; i < fine.num_signals(); ++i) add(signal_scale[i], kSignalTarget);
   ASSERT_EQ(next, values.size());
 
   double worst = 0;
