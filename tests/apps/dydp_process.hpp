@@ -99,6 +99,16 @@ class DydpProcessTest : public TempFolderTest {
       throw std::runtime_error("expected exactly one '" + from + "'");
     return text.replace(at, from.size(), to);
   }
+
+  /// `text` with every `from` replaced by `to`; there must be exactly `count` of them.
+  static std::string replaced_all(std::string text, const std::string& from, const std::string& to, int count) {
+    int found = 0;
+    for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()), ++found)
+      text.replace(at, from.size(), to);
+    if (found != count)
+      throw std::runtime_error("expected " + std::to_string(count) + " of '" + from + "', found " + std::to_string(found));
+    return text;
+  }
 };
 
 }  // namespace dydp::test
