@@ -85,7 +85,20 @@ struct LinearArgs {
   std::string format = "csv";          ///< csv | mat
 };
 
+/// kc: the suspension kinematics of the scene's car.
+struct KcArgs {
+  std::string scene;
+  std::string out = "out";
+  std::vector<std::string> sets;
+  std::string block;         ///< --block: the multibody block (default: the first)
+  double travel = 0.08;      ///< --travel: wheel travel swept each way [m]
+  int points = 33;           ///< --points: poses per wheel travel sweep (odd)
+  bool report = false;
+  std::string format = "csv";
+};
+
 int run_command(const RunArgs& args);
+int kc_command(const KcArgs& args);
 int equilibrium_command(const LinearArgs& args);
 int linearize_command(const LinearArgs& args);
 int modes_command(const LinearArgs& args);

@@ -329,9 +329,23 @@ int frf_command(const LinearArgs& args) {
       for (double v : h.dmagnitude[k][f]) csv << "," << v;
     csv << "\n";
   }
+  // The band's rms of each |H| (with a filter.iso2631 output, the ISO 2631 weighted
+  // transmissibility) and its derivatives: the frequency response's objectives.
+  const engine::BandRms band = engine::band_rms(h);
+  Json objectives = Json::object();
+  for (size_t o = 0; o < p.model.outputs.size(); ++o) {
+    Json sens = Json::object();
+    for (size_t k = 0; k < names.size(); ++k) sens[names[k]] = band.sensitivity[k][o];
+    objectives["rms(|" + p.model.outputs[o] + "/" + in + "|)"] = Json{{"value", band.value[o]}, {"sensitivity", sens}};
+  }
+  const Json frf_json{{"input", in},
+                      {"band_hz", {lo, hi}},
+                      {"definition", "sqrt(integral of |H|^2 df / (hi - lo)), trapezoid rule on the grid of frf.csv"},
+                      {"objectives", objectives}};
   std::filesystem::create_directories(args.out);
   io::write_file_atomically(args.out + "/frf.csv", csv.str());
-  std::string files = "frf.csv";
+  io::write_file_atomically(args.out + "/frf.json", frf_json.dump(2) + "\n");
+  std::string files = "frf.csv, frf.json";
   if (args.report) {
     std::ostringstream md;
     md << "# " << d.scene_name << ": frequency response from " << in << "\n\n"
@@ -367,7 +381,7 @@ int frf_command(const LinearArgs& args) {
     for (size_t f = 0; f < h.H.size(); ++f)
       if (std::abs(h.H[f][o]) > std::abs(h.H[peak][o])) peak = f;
     std::cout << "  " << p.model.outputs[o] << ": peak |H| " << std::setprecision(4) << std::abs(h.H[peak][o]) << " at "
-              << h.frequency_hz[peak] << " Hz\n";
+              << h.frequency_hz[peak] << " Hz, band rms " << band.value[o] << "\n";
   }
   print_done("frequency response", seconds_since(start), args.out, files);
   return 0;

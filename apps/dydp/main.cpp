@@ -129,6 +129,19 @@ int main(int argc, char** argv) {
   frf->add_option("--frequencies", linear_args.frequencies, "LO:HI:N [Hz], log spaced")->capture_default_str();
   frf->add_flag("--report", linear_args.report, "also write the plot (gnuplot) and report.md");
 
+  dydp::apps::KcArgs kc_args;
+  CLI::App* kc = app.add_subcommand("kc", "Suspension kinematics of the scene's car: bump steer, camber gain, track change, "
+                                          "motion ratios, roll centre, roll steer, steering, with their derivatives");
+  kc->add_option("scene", kc_args.scene, "scene file (YAML)")->required();
+  kc->add_option("--out", kc_args.out, "output folder")->capture_default_str();
+  kc->add_option("--set", kc_args.sets, "override a scene parameter: NAME=VALUE");
+  kc->add_option("--block", kc_args.block, "the multibody block (default: the scene's first)");
+  kc->add_option("--travel", kc_args.travel, "wheel travel swept each way [m]")->capture_default_str();
+  kc->add_option("--points", kc_args.points, "poses of the wheel travel sweep (odd)")->capture_default_str();
+  kc->add_flag("--report", kc_args.report, "also write the plots (gnuplot) and report.md");
+  kc->add_option("--format", kc_args.format, "csv: the CSV/JSON files; mat: also a MAT v5 file")
+      ->check(CLI::IsMember({"csv", "mat"}))->capture_default_str();
+
   CLI::App* blocks = app.add_subcommand("blocks", "List the block types with ports and parameters; [direction]: a parameter that can be a "
       "sensitivity direction, written BLOCK.PARAMETER in a scene's sensitivities: list");
 
@@ -150,6 +163,7 @@ int main(int argc, char** argv) {
     if (*linearize) return dydp::apps::linearize_command(linear_args);
     if (*modes) return dydp::apps::modes_command(linear_args);
     if (*frf) return dydp::apps::frf_command(linear_args);
+    if (*kc) return dydp::apps::kc_command(kc_args);
     if (*blocks) return dydp::apps::blocks_command(std::cout);
   } catch (const dydp::engine::InputError& e) {
     err << e.what() << "\n";

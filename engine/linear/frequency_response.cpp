@@ -22,6 +22,29 @@ std::vector<double> log_frequencies(double lo, double hi, int n) {
   return f;
 }
 
+BandRms band_rms(const FrequencyResponse& h) {
+  const size_t nf = h.frequency_hz.size(), no = nf ? h.H[0].size() : 0, np = h.dmagnitude.size();
+  BandRms out;
+  out.value.assign(no, 0.0);
+  out.sensitivity.assign(np, std::vector<double>(no, 0.0));
+  if (nf < 2) return out;
+  const double band = h.frequency_hz.back() - h.frequency_hz.front();
+  for (size_t f = 0; f + 1 < nf; ++f) {
+    const double w = 0.5 * (h.frequency_hz[f + 1] - h.frequency_hz[f]) / band;
+    for (size_t o = 0; o < no; ++o) {
+      const double a = std::abs(h.H[f][o]), b = std::abs(h.H[f + 1][o]);
+      out.value[o] += w * (a * a + b * b);
+      for (size_t p = 0; p < np; ++p)
+        out.sensitivity[p][o] += w * 2.0 * (a * h.dmagnitude[p][f][o] + b * h.dmagnitude[p][f + 1][o]);
+    }
+  }
+  for (size_t o = 0; o < no; ++o) {
+    out.value[o] = std::sqrt(out.value[o]);
+    for (size_t p = 0; p < np; ++p) out.sensitivity[p][o] = out.value[o] > 0 ? out.sensitivity[p][o] / (2.0 * out.value[o]) : 0.0;
+  }
+  return out;
+}
+
 FrequencyResponse frequency_response(const LinearModel& m, FrequencyInput input, const std::vector<double>& frequency_hz,
                                      const std::vector<LinearModelDerivative>& derivatives) {
   const Eigen::Index n = m.A.rows(), no = m.C.rows();

@@ -27,6 +27,17 @@ struct FrequencyResponse {
 FrequencyResponse frequency_response(const LinearModel& m, FrequencyInput input, const std::vector<double>& frequency_hz,
                                      const std::vector<LinearModelDerivative>& derivatives = {});
 
+/// The rms of |H| over the grid's band, per output: T = sqrt(int |H|^2 df / (f_last - f_first)),
+/// the integral by the trapezoid rule on the grid, and dT/dp = int |H| d|H|/dp df / ((f_last -
+/// f_first) T). For an output weighted by a filter.iso2631 block (its a_weighted) it is the
+/// band's ISO 2631 weighted transmissibility: the weighted acceleration's rms per unit input
+/// amplitude for an input whose amplitude spectrum is flat over the band.
+struct BandRms {
+  std::vector<double> value;                     ///< per output
+  std::vector<std::vector<double>> sensitivity;  ///< [parameter][output]
+};
+BandRms band_rms(const FrequencyResponse& h);
+
 /// n frequencies from lo to hi [Hz], log spaced (n >= 2).
 std::vector<double> log_frequencies(double lo, double hi, int n);
 

@@ -18,6 +18,7 @@ LOADED_RADIUS = 0.305        # [m] 0.32 unloaded minus the static deflection, ~3
 CHASSIS_Z0 = 0.17733         # [m] chassis frame origin above the road
 CHASSIS_PITCH0 = 0.001617    # [rad] nose down
 ARB_DROP = 0.25              # [m] anti-roll bar drop link: chassis lever end straight above the arm point
+AXLE = 0.1                   # [m] the axle point (kinematics sensors) outboard of the wheel centre on the spin axis
 
 front = {  # double wishbone, left, front suspension frame
     "spindle": (0.0, 0.7979, -0.1199), "upright_cm": (-0.0224, 0.7470, -0.1118),
@@ -130,7 +131,7 @@ for c, sign in (("fl", 1), ("fr", -1)):
                                 "contact": add(sub(P["spindle"], bo), (0, 0, -LOADED_RADIUS))}))
     bodies.append(dict(name=f"wheel_{c}", parent=f"upright_{c}", offset=sub(P["spindle"], bo),
                        joints=[dict(name=f"spin_{c}", type="Ry")],
-                       mass="wheel", inertia=(0.6, 1.0, 0.6), anchors={"centre": (0, 0, 0)}))
+                       mass="wheel", inertia=(0.6, 1.0, 0.6), anchors={"centre": (0, 0, 0), "axle": (0, AXLE * sign, 0)}))
     cuts.append(f"  - {{name: ball_joint_{c}, type: ball, a: uca_{c}.ball, b: upright_{c}.ball}}")
     cuts.append(f"  - {{name: tie_rod_{c}, type: distance, a: rack.tierod_{c}, b: upright_{c}.tierod, "
                 f"length: {norm(sub(P['tierod_outer'], P['tierod_inner'])):.17g}}}")
@@ -162,7 +163,7 @@ for c, sign in (("rl", 1), ("rr", -1)):
                                 "arb": sub(P["arb_arm"], to)}))
     bodies.append(dict(name=f"wheel_{c}", parent=f"upright_{c}", offset=sub(P["spindle"], uo),
                        joints=[dict(name=f"spin_{c}", type="Ry")],
-                       mass="wheel", inertia=(0.6, 1.0, 0.6), anchors={"centre": (0, 0, 0)}))
+                       mass="wheel", inertia=(0.6, 1.0, 0.6), anchors={"centre": (0, 0, 0), "axle": (0, AXLE * sign, 0)}))
     cuts.append(f"  - {{name: trailing_joint_{c}, type: ball, a: trailing_{c}.upright, b: upright_{c}.trailing}}")
     cuts.append(f"  - {{name: lateral_link_{c}, type: distance, a: chassis.lateral_{c}, b: upright_{c}.lateral, "
                 f"length: {norm(sub(P['lat_upright'], P['lat_chassis'])):.17g}}}")
@@ -279,6 +280,11 @@ for c in ("fl", "fr", "rl", "rr"):
     w(f"  - {{name: wheel_vy_{c}, type: velocity, point: wheel_{c}.centre, frame: upright_{c}, components: [y]}}")
     w(f"  - {{name: wheel_omega_{c}, type: angular_velocity, body: wheel_{c}, frame: upright_{c}, components: [y]}}")
     w(f"  - {{name: wheel_pos_{c}, type: position, point: wheel_{c}.centre}}")
+# For the kinematics and compliance analyses (dydp kc): a point on each wheel's spin axis, outboard
+# of the centre (its direction gives toe and camber), and the contact point (track, roll centre).
+for c in ("fl", "fr", "rl", "rr"):
+    w(f"  - {{name: axle_pos_{c}, type: position, point: wheel_{c}.axle}}")
+    w(f"  - {{name: contact_pos_{c}, type: position, point: upright_{c}.contact}}")
 w("# the chassis, the lower arms (front) and trailing links' pitch (rear) for the wheel travel, the spins")
 w("independent: [x, y, z, yaw, pitch, roll, lca_fl, lca_fr, trailing_rl_pitch, trailing_rr_pitch, "
   "spin_fl, spin_fr, spin_rl, spin_rr]")

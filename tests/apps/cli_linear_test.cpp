@@ -93,6 +93,31 @@ TEST_F(Cli, FrfWritesMagnitudePhaseAndDerivatives) {
   EXPECT_TRUE(fs::exists(dir_ / "f/report.md"));
 }
 
+// The ISO 2631 weighted transmissibility: the band rms of |H| from the pads to the Wk filter's
+// output, with its derivatives, in frf.json; it equals the trapezoid rule over frf.csv's
+// magnitudes, and weighting removes part of what the wheel hop transmits.
+TEST_F(Cli, FrfWritesTheWeightedTransmissibilityWithItsDerivatives) {
+  const Result r = dydp("frf " + quote(sedan()) + " --hold rig.zdot=0 --input rig.z:rig.zdot --output car.body_acc_z --output "
+                        "wk.a_weighted --frequencies 0.5:30:40 --out " + quote((dir_ / "w").string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = read_json(dir_ / "w/frf.json");
+  const json& weighted = j["objectives"]["rms(|wk.a_weighted/rig.z|)"];
+  const json& plain = j["objectives"]["rms(|car.body_acc_z/rig.z|)"];
+  ASSERT_TRUE(weighted.is_object()) << j.dump(1);
+  EXPECT_EQ(weighted["sensitivity"].size(), 18u);
+  // Wk passes 4-10 Hz whole (gain up to 1.05) and halves what lies below 2 Hz and above 25 Hz:
+  // on the sedan, whose pads transmit most at the wheel hop, it removes a quarter.
+  EXPECT_LT(weighted["value"].get<double>(), 0.9 * plain["value"].get<double>());
+  EXPECT_GT(weighted["value"].get<double>(), 0.5 * plain["value"].get<double>());
+  EXPECT_NE(weighted["sensitivity"]["spring_front"].get<double>(), 0.0);
+  const io::CsvFile csv = io::read_csv((dir_ / "w/frf.csv").string());
+  const auto& f = column(csv, "frequency_hz");
+  const auto& mag = column(csv, "magnitude(wk.a_weighted/rig.z)");
+  double sum = 0.0;
+  for (size_t k = 0; k + 1 < f.size(); ++k) sum += 0.5 * (f[k + 1] - f[k]) * (mag[k] * mag[k] + mag[k + 1] * mag[k + 1]);
+  EXPECT_NEAR(weighted["value"].get<double>(), std::sqrt(sum / (f.back() - f.front())), 1e-8 * weighted["value"].get<double>());
+}
+
 TEST_F(Cli, LinearCommandsRefuseUnknownSignalsAndWriteNothing) {
   for (const std::string& args : {"frf " + quote(sedan()) + " --input rig.nope --output car.body_acc_z --out " + quote((dir_ / "bad").string()),
                                   "frf " + quote(sedan()) + " --input rig.z --output car.nothing --out " + quote((dir_ / "bad").string()),
