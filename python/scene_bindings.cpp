@@ -10,6 +10,7 @@
 #include <memory>
 #include <mutex>
 
+#include "engine/analysis/error_estimate.hpp"
 #include "engine/analysis/run.hpp"
 #include "engine/framework/diagram.hpp"
 #include "engine/framework/errors.hpp"
@@ -25,6 +26,7 @@ namespace {
 /// (its blocks' instances are shared by them); scenes loaded apart run in parallel.
 struct Scene {
   engine::Diagram diagram;
+  std::vector<std::pair<std::string, std::string>> overrides;  ///< as loaded (a shadow run loads it again)
   std::unique_ptr<std::mutex> running = std::make_unique<std::mutex>();
 };
 
@@ -87,7 +89,20 @@ RunArrays arrays_of(const engine::Diagram& d, const engine::RunResult& r) {
   return a;
 }
 
-RunArrays run_scene(const Scene& scene, bool sensitivities, const py::object& progress) {
+/// The scene loaded again for a shadow run: its overrides, then its parameters, solver and
+/// sensitivities as they stand (a diagram's blocks are not shared between threads).
+engine::Diagram shadow_of(const Scene& scene) {
+  const engine::Diagram& d = scene.diagram;
+  engine::Diagram shadow = engine::load_scene(d.file, scene.overrides);
+  for (size_t k = 0; k < d.parameters.size(); ++k)
+    if (shadow.parameters[k].value != d.parameters[k].value)
+      shadow.set_parameter(static_cast<int>(k), d.parameters[k].value, /*check_range=*/false);
+  shadow.solver = d.solver;
+  shadow.set_sensitivities(d.sensitivities);
+  return shadow;
+}
+
+RunArrays run_scene(const Scene& scene, bool sensitivities, const py::object& progress, bool estimate) {
   engine::RunOptions options;
   options.sensitivities = sensitivities;
   if (!progress.is_none()) {
@@ -101,7 +116,12 @@ RunArrays run_scene(const Scene& scene, bool sensitivities, const py::object& pr
   {
     py::gil_scoped_release released;
     const std::lock_guard<std::mutex> turn(*scene.running);
-    r = engine::run(scene.diagram, options);
+    if (estimate) {
+      engine::Diagram shadow = shadow_of(scene);
+      r = engine::run_with_error_estimate(scene.diagram, shadow, options);
+    } else {
+      r = engine::run(scene.diagram, options);
+    }
   }
   return arrays_of(scene.diagram, r);
 }
@@ -112,6 +132,7 @@ std::unique_ptr<Scene> load(const std::filesystem::path& path, const py::dict& o
   try {
     auto scene = std::make_unique<Scene>();
     scene->diagram = engine::load_scene(path.string(), sets);
+    scene->overrides = sets;
     return scene;
   } catch (const engine::InputError& e) {
     // The loader names an override by its command-line option; here it came from `overrides`.
@@ -197,7 +218,9 @@ void add_scene_bindings(py::module_& m) {
           },
           py::arg("name"), py::arg("value"), "sets a scene parameter (checked against its range)")
       .def("run", &run_scene, py::arg("sensitivities") = true, py::arg("progress") = py::none(),
-           "Runs the scene (the GIL released); progress(t) is called at every output time. "
+           py::arg("estimate") = true,
+           "Runs the scene (the GIL released); progress(t) is called at every output time; estimate: "
+           "a shadow run beside it estimates its error (stats['error_estimate'], as run.json). "
            "Runs of one scene take turns; load a scene per thread to run in parallel.")
       .def("__repr__", [](const Scene& s) { return "<dydp.Scene " + s.diagram.scene_name + " from " + s.diagram.file + ">"; });
 
@@ -206,12 +229,14 @@ void add_scene_bindings(py::module_& m) {
         "Bad input raises dydp.InputError with file, line and field.");
   m.def(
       "run",
-      [](const std::filesystem::path& path, const py::dict& overrides, bool sensitivities, const py::object& progress) {
+      [](const std::filesystem::path& path, const py::dict& overrides, bool sensitivities, const py::object& progress,
+         bool estimate) {
         const std::unique_ptr<Scene> scene = load(path, overrides);
-        return run_scene(*scene, sensitivities, progress);
+        return run_scene(*scene, sensitivities, progress, estimate);
       },
       py::arg("scene"), py::arg("overrides") = py::dict(), py::arg("sensitivities") = true,
-      py::arg("progress") = py::none(), "load(scene, overrides).run(sensitivities, progress)");
+      py::arg("progress") = py::none(), py::arg("estimate") = true,
+      "load(scene, overrides).run(sensitivities, progress, estimate)");
 }
 
 }  // namespace dydp::python

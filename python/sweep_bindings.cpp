@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "engine/studies/sweep.hpp"
@@ -19,11 +20,11 @@ struct SweepArrays {
   std::string parameter, unit;
   std::vector<std::string> objective_names, objective_units;
   std::vector<double> fd_steps;
-  py::array_t<double> p, values, gradients, fd, cpu_seconds;
+  py::array_t<double> p, values, gradients, fd, cpu_seconds, error_signals, error_sensitivities;
 };
 
 SweepArrays sweep(const std::filesystem::path& path, const std::string& parameter, double low, double high, int points,
-                  const py::dict& overrides, const std::vector<double>& fd_steps, int threads) {
+                  const py::dict& overrides, const std::vector<double>& fd_steps, int threads, bool estimate) {
   engine::SweepSpec spec;
   spec.scene = path.string();
   spec.overrides = overrides_from(overrides);
@@ -31,6 +32,7 @@ SweepArrays sweep(const std::filesystem::path& path, const std::string& paramete
   spec.low = low, spec.high = high, spec.points = points;
   spec.fd_steps = fd_steps;
   spec.threads = threads;
+  spec.estimate = estimate;
   engine::SweepResult r;
   {
     py::gil_scoped_release released;
@@ -44,11 +46,15 @@ SweepArrays sweep(const std::filesystem::path& path, const std::string& paramete
   const py::ssize_t nh = static_cast<py::ssize_t>(r.fd_steps.size());
   a.p = py::array_t<double>(n);
   a.cpu_seconds = py::array_t<double>(n);
+  a.error_signals = py::array_t<double>(n);
+  a.error_sensitivities = py::array_t<double>(n);
   a.values = py::array_t<double>({n, no});
   a.gradients = py::array_t<double>({n, no});
   a.fd = py::array_t<double>({n, nh, no});
   auto p = a.p.mutable_unchecked<1>();
   auto cpu = a.cpu_seconds.mutable_unchecked<1>();
+  auto es = a.error_signals.mutable_unchecked<1>();
+  auto ed = a.error_sensitivities.mutable_unchecked<1>();
   auto psi = a.values.mutable_unchecked<2>();
   auto dpsi = a.gradients.mutable_unchecked<2>();
   auto fd = a.fd.mutable_unchecked<3>();
@@ -56,6 +62,9 @@ SweepArrays sweep(const std::filesystem::path& path, const std::string& paramete
     const engine::SweepPoint& pt = r.points[k];
     p(k) = pt.p;
     cpu(k) = pt.stats.cpu_seconds;
+    const engine::ErrorEstimate& e = pt.stats.error_estimate;
+    es(k) = e.estimated ? e.signal_error : std::nan("");
+    ed(k) = e.estimated ? e.sensitivity_error : std::nan("");
     for (py::ssize_t o = 0; o < no; ++o) {
       psi(k, o) = pt.psi[o];
       dpsi(k, o) = pt.dpsi[o];
@@ -79,14 +88,20 @@ void add_sweep_bindings(py::module_& m) {
       .def_readonly("gradients", &SweepArrays::gradients, "d(psi)/dp, shape (points, objectives)")
       .def_readonly("fd", &SweepArrays::fd, "central differences, shape (points, fd_steps, objectives)")
       .def_readonly("cpu_seconds", &SweepArrays::cpu_seconds, "per point, shape (points,)")
+      .def_readonly("error_estimate_signals", &SweepArrays::error_signals,
+                    "each point's estimate of its own error in the logged signals (NaN: not estimated), shape (points,)")
+      .def_readonly("error_estimate_sensitivities", &SweepArrays::error_sensitivities,
+                    "the same for their sensitivity columns, shape (points,)")
       .def("__repr__", [](const SweepArrays& a) {
         return "<dydp.SweepResult: " + a.parameter + " at " + std::to_string(a.p.size()) + " points, " +
                std::to_string(a.objective_names.size()) + " objectives>";
       });
   m.def("sweep", &sweep, py::arg("scene"), py::arg("parameter"), py::arg("low"), py::arg("high"), py::arg("points"),
         py::arg("overrides") = py::dict(), py::arg("fd_steps") = std::vector<double>{}, py::arg("threads") = 0,
+        py::arg("estimate") = true,
         "Sweeps a scene parameter over [low, high] at `points` points (as dydp sweep --range LO:HI:N); "
-        "fd_steps adds central differences at those absolute steps; threads 0: one per core.");
+        "fd_steps adds central differences at those absolute steps; threads 0: one per core; estimate: each "
+        "point's run estimates its own error by a shadow run (False: none, half the CPU).");
 }
 
 }  // namespace dydp::python

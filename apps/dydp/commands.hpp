@@ -31,6 +31,7 @@ struct SweepArgs {
   std::string range;              ///< LO:HI:N
   std::vector<double> fd_steps;   ///< --fd: absolute steps for central differences
   double delta = 0.0;             ///< --delta: report the change of psi for this step of p
+  bool no_estimate = false;       ///< --no-estimate: no shadow runs (no error estimates)
   bool report = false;
   std::string format = "csv";     ///< csv | mat (also sweep.mat)
 };

@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
   sweep->add_option("--fd", sweep_args.fd_steps, "central differences at these absolute steps")->delimiter(',');
   sweep->add_option("--delta", sweep_args.delta, "report the change of psi for this step of the parameter");
   sweep->add_flag("--report", sweep_args.report, "also write plots (gnuplot) and report.md");
+  sweep->add_flag("--no-estimate", sweep_args.no_estimate, "no shadow runs: the points' error is not estimated (half the CPU)");
   add_solver_options(sweep, sweep_args.solver);
   sweep->add_option("--format", sweep_args.format, "csv: the CSV/JSON files; mat: also sweep.mat (MAT v5)")
       ->check(CLI::IsMember({"csv", "mat"}))->capture_default_str();

@@ -40,7 +40,7 @@ std::string sweep_csv(const engine::SweepResult& r, double delta) {
     if (delta > 0) out << ",change(" << o << ")for_step_" << delta;
     for (double h : r.fd_steps) out << ",fd(" << o << ")h=" << h << ",fd_error(" << o << ")h=" << h;
   }
-  out << ",cpu_seconds\n";
+  out << ",cpu_seconds,error_estimate_signals,error_estimate_sensitivities\n";
   for (const auto& pt : r.points) {
     out << pt.p;
     for (size_t o = 0; o < r.objectives.size(); ++o) {
@@ -50,7 +50,12 @@ std::string sweep_csv(const engine::SweepResult& r, double delta) {
       for (size_t s = 0; s < r.fd_steps.size(); ++s)
         out << ',' << pt.fd[s][o] << ',' << std::fabs(pt.fd[s][o] - pt.dpsi[o]) / std::max(std::fabs(pt.dpsi[o]), 1e-300);
     }
-    out << ',' << pt.stats.cpu_seconds << '\n';
+    const engine::ErrorEstimate& e = pt.stats.error_estimate;
+    out << ',' << pt.stats.cpu_seconds;
+    if (e.estimated)
+      out << ',' << e.signal_error << ',' << e.sensitivity_error << '\n';
+    else
+      out << ",nan,nan\n";
   }
   return out.str();
 }
@@ -70,6 +75,7 @@ int sweep_command(const SweepArgs& args) {
   if (!(args.delta >= 0 && std::isfinite(args.delta)))
     throw engine::InputError("--delta", 0, engine::format_number(args.delta), "must be positive (0: no change column)");
   spec.keep_runs = args.report;
+  spec.estimate = !args.no_estimate;
   if (engine::world_rank() == 0)
     std::cerr << "sweep: " << spec.points << " runs of " << args.scene << " over " << spec.parameter
             << " in [" << spec.low << ", " << spec.high << "]"
@@ -87,6 +93,13 @@ int sweep_command(const SweepArgs& args) {
   j["fd_steps"] = r.fd_steps;
   for (const auto& pt : r.points) {
     nlohmann::ordered_json p = {{"p", pt.p}, {"cpu_seconds", pt.stats.cpu_seconds}};
+    const engine::ErrorEstimate& e = pt.stats.error_estimate;
+    p["error_estimate"] = nullptr;
+    if (e.estimated)
+      p["error_estimate"] = {{"signals", e.signal_error}, {"sensitivities", e.sensitivity_error},
+                             {"worst_signal", e.worst_signal}, {"worst_sensitivity", e.worst_sensitivity},
+                             {"how", e.how}};
+    p["warnings"] = pt.stats.warnings;
     for (size_t o = 0; o < r.objectives.size(); ++o) {
       nlohmann::ordered_json obj = {{"value", pt.psi[o]}, {"sensitivity", pt.dpsi[o]},
                                     {"normalised", pt.psi[o] != 0 ? pt.p / pt.psi[o] * pt.dpsi[o] : 0.0}};
@@ -115,6 +128,24 @@ int sweep_command(const SweepArgs& args) {
       std::cout << "\n";
     }
   }
+  // Each point's own error estimate: the worst of them, and every point above the target on stderr.
+  const engine::SweepPoint* worst_signal = nullptr;
+  const engine::SweepPoint* worst_sens = nullptr;
+  for (const auto& pt : r.points) {
+    const engine::ErrorEstimate& e = pt.stats.error_estimate;
+    if (!e.estimated) continue;
+    if (!worst_signal || e.signal_error > worst_signal->stats.error_estimate.signal_error) worst_signal = &pt;
+    if (!worst_sens || e.sensitivity_error > worst_sens->stats.error_estimate.sensitivity_error) worst_sens = &pt;
+    for (const std::string& w : pt.stats.warnings) std::cerr << "warning: at " << r.parameter << " = " << pt.p << ": " << w << "\n";
+  }
+  if (worst_signal)
+    std::cout << "  estimated error (each run's own, " << worst_signal->stats.error_estimate.how << "): signals up to "
+              << std::setprecision(2) << 100 * worst_signal->stats.error_estimate.signal_error << " % (at "
+              << r.parameter << " = " << std::setprecision(6) << worst_signal->p << "), sensitivities up to "
+              << std::setprecision(2) << 100 * worst_sens->stats.error_estimate.sensitivity_error << " % (at "
+              << std::setprecision(6) << worst_sens->p << ")\n";
+  else if (args.no_estimate)
+    std::cout << "  no error estimates (--no-estimate)\n";
   std::cout << "results in " << args.out << "/ (sweep.csv, sweep.json" << (args.format == "mat" ? ", sweep.mat" : "")
             << (args.report ? ", report.md" : "") << ")\n";
   return 0;

@@ -34,7 +34,10 @@ ShadowPlan shadow_plan(const SolverSpec& solver, const TimeSpec& time) {
   plan.solver = solver;
   const int order = fixed_order(solver);
   if (order > 0) {
-    const double step = solver.step > 0 ? solver.step : time.output_step / 10.0;
+    const double asked = solver.step > 0 ? solver.step : time.output_step / 10.0;
+    // The step the run takes: each output interval in the fewest equal steps of at most the
+    // one asked (a step above the output step is the output step).
+    const double step = time.output_step / std::max(1.0, std::ceil(time.output_step / asked - 1e-9));
     // Half the step, not twice: a fixed step already near its limit (a damper's valve it can
     // barely follow) would fail at twice the step and leave the run without an estimate.
     plan.solver.step = step / 2;

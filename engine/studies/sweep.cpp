@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "engine/analysis/error_estimate.hpp"
 #include "engine/analysis/run.hpp"
 #include "engine/framework/errors.hpp"
 #include "engine/studies/run_sharing.hpp"
@@ -59,12 +60,28 @@ SweepResult sweep(const SweepSpec& spec) {
   // the same text whether it was computed by a thread of this process or by another MPI rank.
   auto run_point = [&](int k) {
     const double p = result.points[k].p;
-    Diagram d = load(spec);
-    d.set_parameter(index, p);
     // The swept parameter is the one sensitivity direction the sweep needs.
-    d.set_sensitivities({index});
-    const RunResult r = run(d);
+    auto at_point = [&]() {
+      Diagram d = load(spec);
+      d.set_parameter(index, p);
+      d.set_sensitivities({index});
+      return d;
+    };
+    const Diagram d = at_point();
+    RunResult r;
+    if (spec.estimate) {
+      Diagram shadow = at_point();
+      r = run_with_error_estimate(d, shadow, RunOptions{});
+    } else {
+      r = run(d);
+    }
     nlohmann::json j;
+    const ErrorEstimate& e = r.stats.error_estimate;
+    if (e.estimated)
+      j["error_estimate"] = {{"signals", e.signal_error}, {"sensitivities", e.sensitivity_error},
+                             {"worst_signal", e.worst_signal}, {"worst_sensitivity", e.worst_sensitivity},
+                             {"how", e.how}, {"cpu_seconds", e.cpu_seconds}};
+    j["warnings"] = r.stats.warnings;
     for (const auto& obj : r.objectives) {
       j["psi"].push_back(obj.value);
       j["dpsi"].push_back(obj.sensitivity[0]);
@@ -92,6 +109,18 @@ SweepResult sweep(const SweepSpec& spec) {
     pt.fd = j["fd"].get<std::vector<std::vector<double>>>();
     pt.stats.cpu_seconds = j["cpu_seconds"];
     pt.stats.steps = j["steps"];
+    if (j.contains("error_estimate")) {
+      const auto& e = j["error_estimate"];
+      ErrorEstimate& est = pt.stats.error_estimate;
+      est.estimated = true;
+      est.signal_error = e["signals"];
+      est.sensitivity_error = e["sensitivities"];
+      est.worst_signal = e["worst_signal"];
+      est.worst_sensitivity = e["worst_sensitivity"];
+      est.how = e["how"];
+      est.cpu_seconds = e["cpu_seconds"];
+    }
+    pt.stats.warnings = j["warnings"].get<std::vector<std::string>>();
     if (j.contains("run")) {
       const auto& run = j["run"];
       pt.run.signal_names = run["signal_names"].get<std::vector<std::string>>();

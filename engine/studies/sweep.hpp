@@ -21,6 +21,9 @@ struct SweepSpec {
   std::vector<double> fd_steps;  ///< absolute steps for central differences; empty: none
   int threads = 0;               ///< 0: one per core
   bool keep_runs = false;        ///< keep every run's full result (for reports)
+  /// Each point's run estimates its own error (a shadow run beside it,
+  /// engine/analysis/error_estimate.hpp); false: no shadow runs.
+  bool estimate = true;
 };
 
 struct SweepPoint {
@@ -28,7 +31,7 @@ struct SweepPoint {
   std::vector<double> psi;            ///< per objective
   std::vector<double> dpsi;           ///< per objective, d(psi)/dp for the swept parameter
   std::vector<std::vector<double>> fd;  ///< fd[s][o]: central difference with step s
-  RunStats stats;                     ///< cpu_seconds and steps only
+  RunStats stats;                     ///< cpu_seconds, steps, error_estimate and warnings only
   RunResult run;                      ///< when keep_runs: names, t, values, tangents
 };
 

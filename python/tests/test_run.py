@@ -11,6 +11,22 @@ import dydp
 from conftest import dydp_cli, read_json, read_signals_csv, scene_path
 
 
+def test_a_run_estimates_its_own_error_as_the_cli_does(tmp_path, short_msd):
+    """stats["error_estimate"] is run.json's: the same shadow run, also after set_parameter."""
+    dydp_cli("run", short_msd, "--set", "damping=2.0", "--out", tmp_path)
+    cli = read_json(tmp_path / "run.json")["error_estimate"]
+    scene = dydp.load(short_msd)
+    scene.set_parameter("damping", 2.0)
+    est = scene.run().stats["error_estimate"]
+    assert est["how"] == cli["how"] == "shadow run at 4 x rtol and atol"
+    for key in ("signals", "sensitivities", "worst_signal", "worst_sensitivity"):
+        assert est[key] == cli[key], key
+    assert 0 < est["signals"] < 0.01
+    # the shadow follows the scene's parameter: at the default damping the estimate differs
+    assert dydp.run(short_msd).stats["error_estimate"]["signals"] != est["signals"]
+    assert scene.run(estimate=False).stats["error_estimate"] is None
+
+
 def test_quarter_car_objectives_equal_the_cli_to_the_last_digit(tmp_path):
     scene = scene_path("quarter_car_cdc.yaml")
     dydp_cli("run", scene, "--out", tmp_path)

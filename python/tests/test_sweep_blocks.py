@@ -20,6 +20,10 @@ def test_sweep_equals_the_cli(tmp_path, short_msd):
         o = point["objectives"]["x_rms"]
         assert s.values[k, 0] == o["value"]
         assert s.gradients[k, 0] == o["sensitivity"]
+        # each point's own error estimate, as the CLI's
+        assert s.error_estimate_signals[k] == point["error_estimate"]["signals"]
+        assert s.error_estimate_sensitivities[k] == point["error_estimate"]["sensitivities"]
+        assert 0 < s.error_estimate_signals[k] < 0.01
         assert s.fd[k, 0, 0] == o["fd"][0]["value"]
     # The exact derivative against the central difference at each point.
     np.testing.assert_allclose(s.fd[:, 0, 0], s.gradients[:, 0], rtol=1e-3)

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -46,6 +47,57 @@ TEST_F(Cli, SweepReportsExactDerivativesThatCentralDifferencesApproach) {
   }
   const auto rows = split(read_text(out / "sweep.csv"), '\n');
   EXPECT_EQ(rows.size(), 4u);  // header + 3 points
+}
+
+// Every point of a sweep estimates its own error as a run does (a shadow run beside it): the
+// estimate of each point equals that of `dydp run` on the same scene at that point with the
+// same sensitivity, and a point whose estimate is above the target says so on stderr.
+TEST_F(Cli, SweepPointsEstimateTheirOwnErrorAsARunDoes) {
+  const fs::path out = dir_ / "sweep";
+  const Result r = dydp("sweep " + quote(msd_scene()) + " --param damping --range 0.5:2.5:3 --out " + quote(out.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("estimated error (each run's own"), std::string::npos) << r.out;
+  const json j = json::parse(read_text(out / "sweep.json"));
+  ASSERT_EQ(j["points"].size(), 3u);
+  // The same scene with the swept parameter as its one sensitivity, run at the middle point.
+  const fs::path scene = dir_ / "msd_damping.yaml";
+  {
+    std::ofstream f(scene);
+    f << replaced(read_text(msd_scene()), "sensitivities: [mass, stiffness, damping]", "sensitivities: [damping]");
+  }
+  const Result one = dydp("run " + quote(scene.string()) + " --set damping=1.5 --out " + quote((dir_ / "run").string()));
+  ASSERT_EQ(one.status, 0) << one.err;
+  const json run = json::parse(read_text(dir_ / "run/run.json"));
+  const json& expected = run["error_estimate"];
+  const json& got = j["points"][1]["error_estimate"];
+  ASSERT_TRUE(got.is_object()) << j["points"][1].dump();
+  EXPECT_GT(got["signals"].get<double>(), 0.0);
+  EXPECT_NEAR(got["signals"].get<double>(), expected["signals"].get<double>(), 1e-12);
+  EXPECT_NEAR(got["sensitivities"].get<double>(), expected["sensitivities"].get<double>(), 1e-12);
+  EXPECT_EQ(got["how"], expected["how"]);
+  EXPECT_TRUE(j["points"][0]["warnings"].empty());
+  const auto header = split(split(read_text(out / "sweep.csv"), '\n')[0], ',');
+  EXPECT_EQ(header.back(), "error_estimate_sensitivities");
+
+  // RK4 at 0.25 s (outputs every 0.25 s) on a 0.8 Hz drive and a 0.8 Hz mass, 5 steps a period:
+  // far above the 1 % target, and said.
+  const fs::path coarse_scene = dir_ / "msd_coarse.yaml";
+  {
+    std::ofstream f(coarse_scene);
+    f << replaced(read_text(msd_scene()), "output_step: 0.01", "output_step: 0.25");
+  }
+  const Result coarse = dydp("sweep " + quote(coarse_scene.string()) +
+                             " --param damping --range 0.5:2.5:2 --solver rk4 --step 0.25 --out " +
+                             quote((dir_ / "coarse").string()));
+  ASSERT_EQ(coarse.status, 0) << coarse.err;
+  EXPECT_NE(coarse.err.find("warning: at damping = 0.5: estimated error"), std::string::npos) << coarse.err;
+  const json c = json::parse(read_text(dir_ / "coarse/sweep.json"));
+  EXPECT_GT(c["points"][0]["error_estimate"]["signals"].get<double>(), 0.01);
+  // --no-estimate: no shadow runs, and none claimed.
+  const Result none = dydp("sweep " + quote(msd_scene()) + " --param damping --range 0.5:2.5:2 --no-estimate --out " +
+                           quote((dir_ / "none").string()));
+  ASSERT_EQ(none.status, 0) << none.err;
+  EXPECT_TRUE(json::parse(read_text(dir_ / "none/sweep.json"))["points"][0]["error_estimate"].is_null());
 }
 
 TEST_F(Cli, SweepOfAnUnknownParameterExitsTwo) {
