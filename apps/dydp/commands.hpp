@@ -68,6 +68,7 @@ struct ScreenArgs {
   bool report = false;
   bool resume = false;
   int threads = 0;                ///< --threads: 0 one per core (one per rank under MPI)
+  bool no_estimate = false;       ///< --no-estimate: no shadow runs
 };
 
 /// equilibrium, linearize, modes, frf: the analyses about one operating point.

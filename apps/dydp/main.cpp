@@ -99,6 +99,7 @@ int main(int argc, char** argv) {
   screen->add_option("--out", screen_args.out, "output folder (runs recorded in OUT/runs/)")->capture_default_str();
   screen->add_option("--set", screen_args.sets, "override a scene parameter: NAME=VALUE");
   screen->add_flag("--report", screen_args.report, "also write plots (gnuplot) and report.md");
+  screen->add_flag("--no-estimate", screen_args.no_estimate, "no shadow runs: the runs' error is not estimated (half the CPU)");
   screen->add_flag("--resume", screen_args.resume, "keep the runs recorded in OUT/runs/ and run only the missing ones");
   screen->add_option("--threads", screen_args.threads, "runs at a time (0: one per core; one per rank under MPI)")
       ->capture_default_str();

@@ -50,7 +50,7 @@ std::string samples_csv(const engine::ScreenResult& r) {
     out << ',' << o;
     for (const auto& g : r.ranges) out << ",d(" << o << ")/d(" << g.name << ")";
   }
-  out << ",cpu_seconds\n";
+  out << ",cpu_seconds,error_estimate_signals,error_estimate_sensitivities\n";
   auto row = [&](const engine::ScreenRun& s) {
     out << s.index;
     for (double p : s.p) out << ',' << p;
@@ -58,11 +58,17 @@ std::string samples_csv(const engine::ScreenResult& r) {
       out << ',' << s.psi[o];
       for (double g : s.gradient[o]) out << ',' << g;
     }
-    out << ',' << s.cpu_seconds << '\n';
+    out << ',' << s.cpu_seconds << ',' << s.error_signals << ',' << s.error_sensitivities << '\n';
   };
   row(r.nominal);
   for (const auto& s : r.samples) row(s);
   return out.str();
+}
+
+std::vector<const engine::ScreenRun*> all_runs(const engine::ScreenResult& r) {
+  std::vector<const engine::ScreenRun*> runs{&r.nominal};
+  for (const auto& s : r.samples) runs.push_back(&s);
+  return runs;
 }
 
 nlohmann::ordered_json screen_json(const engine::ScreenResult& r, const std::string& scene) {
@@ -93,6 +99,23 @@ nlohmann::ordered_json screen_json(const engine::ScreenResult& r, const std::str
   for (const auto& s : r.samples) cpu += s.cpu_seconds, steps += s.steps;
   j["runs"] = {{"count", r.samples.size() + 1}, {"recorded_before", r.recorded_before}, {"cpu_seconds", cpu},
                {"steps", steps}};
+  // The runs' own error estimates: the worst of them (samples.csv has each).
+  const engine::ScreenRun* worst_signal = nullptr;
+  const engine::ScreenRun* worst_sens = nullptr;
+  int estimated = 0;
+  for (const engine::ScreenRun* s : all_runs(r)) {
+    if (!std::isfinite(s->error_signals)) continue;
+    ++estimated;
+    if (!worst_signal || s->error_signals > worst_signal->error_signals) worst_signal = s;
+    if (!worst_sens || s->error_sensitivities > worst_sens->error_sensitivities) worst_sens = s;
+  }
+  j["runs"]["error_estimate"] = nullptr;
+  if (worst_signal)
+    j["runs"]["error_estimate"] = {{"estimated_runs", estimated},
+                                   {"signals", worst_signal->error_signals},
+                                   {"signals_run", worst_signal->index},
+                                   {"sensitivities", worst_sens->error_sensitivities},
+                                   {"sensitivities_run", worst_sens->index}};
   return j;
 }
 
@@ -110,6 +133,7 @@ int screen_command(const ScreenArgs& args) {
   spec.out = args.out;
   spec.resume = args.resume;
   spec.threads = args.threads;
+  spec.estimate = !args.no_estimate;
   const bool speaker = engine::world_rank() == 0;
   ProgressBar bar("screen");
   spec.progress = [&](int done, int todo) { bar.update(done, todo); };
@@ -127,7 +151,10 @@ int screen_command(const ScreenArgs& args) {
 
   io::write_file_atomically(args.out + "/screen.csv", measures_csv(r));
   io::write_file_atomically(args.out + "/samples.csv", samples_csv(r));
-  io::write_file_atomically(args.out + "/screen.json", screen_json(r, args.scene).dump(2) + "\n");
+  const nlohmann::ordered_json sj = screen_json(r, args.scene);
+  io::write_file_atomically(args.out + "/screen.json", sj.dump(2) + "\n");
+  for (const engine::ScreenRun* s : all_runs(r))
+    for (const std::string& w : s->warnings) std::cerr << "warning: run " << s->index << ": " << w << "\n";
   if (args.report) write_screen_report(args.out, args.scene, r);
 
   std::cout << std::setprecision(4);
@@ -146,6 +173,12 @@ int screen_command(const ScreenArgs& args) {
                 << swing(r, static_cast<int>(o), i) << std::setw(12) << m.local_normalised << "\n";
     }
   }
+  const auto& est = sj["runs"]["error_estimate"];
+  if (est.is_object())
+    std::cout << "estimated error (each run's own, " << est["estimated_runs"].get<int>() << " runs): signals up to "
+              << std::setprecision(2) << 100 * est["signals"].get<double>() << " % (run " << est["signals_run"].get<int>()
+              << "), sensitivities up to " << 100 * est["sensitivities"].get<double>() << " % (run "
+              << est["sensitivities_run"].get<int>() << ")\n";
   std::cout << "results in " << args.out << "/ (screen.csv, samples.csv, screen.json" << (args.report ? ", report.md" : "")
             << "; one record per run in runs/)\n";
   return 0;

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+
+#include "engine/analysis/error_estimate.hpp"
 #include <set>
 #include <sstream>
 
@@ -63,7 +65,9 @@ ordered_json identity(const ScreenSpec& spec, const ScreenResult& r, const Diagr
 
 std::string encode(const ScreenRun& run) {
   ordered_json j = {{"index", run.index}, {"p", run.p}, {"psi", run.psi}, {"gradient", run.gradient},
-                    {"cpu_seconds", run.cpu_seconds}, {"steps", run.steps}};
+                    {"cpu_seconds", run.cpu_seconds}, {"steps", run.steps}, {"warnings", run.warnings}};
+  if (std::isfinite(run.error_signals))
+    j["error_estimate"] = {{"signals", run.error_signals}, {"sensitivities", run.error_sensitivities}};
   return j.dump() + "\n";
 }
 
@@ -76,6 +80,11 @@ ScreenRun decode(const std::string& text) {
   run.gradient = j.at("gradient").get<std::vector<std::vector<double>>>();
   run.cpu_seconds = j.at("cpu_seconds");
   run.steps = j.at("steps");
+  if (j.contains("error_estimate")) {  // records written with --no-estimate have none
+    run.error_signals = j["error_estimate"].at("signals");
+    run.error_sensitivities = j["error_estimate"].at("sensitivities");
+  }
+  if (j.contains("warnings")) run.warnings = j["warnings"].get<std::vector<std::string>>();
   return run;
 }
 
@@ -183,11 +192,21 @@ ScreenResult screen(const ScreenSpec& spec) {
     if (!have[k]) todo.push_back(k);
 
   auto run_one = [&](int k) {
-    Diagram d = load(spec);
     const std::vector<double> p = point(k);
-    for (int i = 0; i < P; ++i) d.set_parameter(indices[i], p[i]);
-    d.set_sensitivities(indices);
-    const RunResult result = run(d);
+    auto at_point = [&]() {
+      Diagram d = load(spec);
+      for (int i = 0; i < P; ++i) d.set_parameter(indices[i], p[i]);
+      d.set_sensitivities(indices);
+      return d;
+    };
+    const Diagram d = at_point();
+    RunResult result;
+    if (spec.estimate) {
+      Diagram shadow = at_point();
+      result = run_with_error_estimate(d, shadow, RunOptions{});
+    } else {
+      result = run(d);
+    }
     ScreenRun sr;
     sr.index = k;
     sr.p = p;
@@ -197,6 +216,11 @@ ScreenResult screen(const ScreenSpec& spec) {
     }
     sr.cpu_seconds = result.stats.cpu_seconds;
     sr.steps = result.stats.steps;
+    if (result.stats.error_estimate.estimated) {
+      sr.error_signals = result.stats.error_estimate.signal_error;
+      sr.error_sensitivities = result.stats.error_estimate.sensitivity_error;
+    }
+    sr.warnings = result.stats.warnings;
     return encode(sr);
   };
   int done = 0;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,7 @@ struct ScreenSpec {
   std::string out;                      ///< the runs are recorded in out/runs/
   bool resume = false;                  ///< keep the records of out/runs/, run only what is missing
   int threads = 0;                      ///< 0: one per core (one per rank under MPI)
+  bool estimate = true;                 ///< each run estimates its own error (a shadow run beside it)
   /// Called on rank 0 after each recorded run: runs recorded so far in this invocation, runs
   /// this invocation has to do.
   std::function<void(int done, int todo)> progress;
@@ -36,6 +38,10 @@ struct ScreenRun {
   std::vector<std::vector<double>> gradient;  ///< gradient[o][i] = dpsi_o/dp_i
   double cpu_seconds = 0.0;
   long steps = 0;
+  /// The run's own error estimate (engine/analysis/error_estimate.hpp), NaN when not estimated.
+  double error_signals = std::numeric_limits<double>::quiet_NaN();
+  double error_sensitivities = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::string> warnings;  ///< the run's (an estimate above the target)
 };
 
 struct ScreenResult {

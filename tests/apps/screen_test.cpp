@@ -213,6 +213,17 @@ TEST_F(Screen, MeasuresFollowFromTheSamplesAndGradientsFromSingleRuns) {
   EXPECT_EQ(o["value"].get<double>(), psi[5]);
   EXPECT_EQ(o["sensitivity"]["stiffness"].get<double>(), dk[5]);
   EXPECT_EQ(o["sensitivity"]["damping"].get<double>(), dc[5]);
+  // Each run estimated its own error as that run does (its shadow run beside it).
+  const json est = json::parse(read_text(single / "run.json"))["error_estimate"];
+  ASSERT_TRUE(est.is_object());
+  EXPECT_NEAR(column(samples, "error_estimate_signals")[5], est["signals"].get<double>(), 1e-15);
+  EXPECT_NEAR(column(samples, "error_estimate_sensitivities")[5], est["sensitivities"].get<double>(), 1e-15);
+  const json& worst = j["runs"]["error_estimate"];
+  ASSERT_TRUE(worst.is_object());
+  EXPECT_EQ(worst["estimated_runs"].get<int>(), 17);
+  const auto& es = column(samples, "error_estimate_signals");
+  EXPECT_EQ(worst["signals"].get<double>(), *std::max_element(es.begin(), es.end()));
+  EXPECT_GT(worst["signals"].get<double>(), 0.0);
 }
 
 TEST_F(Screen, ReportShowsTheRankingAsATornadoAndTheSamplesOfEachParameter) {
