@@ -13,6 +13,7 @@
 #include "engine/analysis/run.hpp"
 #include "engine/framework/diagram.hpp"
 #include "engine/framework/errors.hpp"
+#include "engine/studies/initial_equilibrium.hpp"
 #include "io/output_writer.hpp"
 #include "python/bindings.hpp"
 
@@ -87,7 +88,7 @@ RunArrays arrays_of(const engine::Diagram& d, const engine::RunResult& r) {
   return a;
 }
 
-RunArrays run_scene(const Scene& scene, bool sensitivities, const py::object& progress) {
+RunArrays run_scene(Scene& scene, bool sensitivities, const py::object& progress) {
   engine::RunOptions options;
   options.sensitivities = sensitivities;
   if (!progress.is_none()) {
@@ -101,7 +102,7 @@ RunArrays run_scene(const Scene& scene, bool sensitivities, const py::object& pr
   {
     py::gil_scoped_release released;
     const std::lock_guard<std::mutex> turn(*scene.running);
-    r = engine::run(scene.diagram, options);
+    r = engine::run_from_initial(scene.diagram, options);  // `initial: equilibrium`: its start first
   }
   return arrays_of(scene.diagram, r);
 }

@@ -11,6 +11,7 @@
 
 #include "engine/analysis/run.hpp"
 #include "engine/framework/errors.hpp"
+#include "engine/studies/initial_equilibrium.hpp"
 #include "engine/studies/run_sharing.hpp"
 #include "engine/studies/sobol_points.hpp"
 #include "io/files.hpp"
@@ -187,7 +188,7 @@ ScreenResult screen(const ScreenSpec& spec) {
     const std::vector<double> p = point(k);
     for (int i = 0; i < P; ++i) d.set_parameter(indices[i], p[i]);
     d.set_sensitivities(indices);
-    const RunResult result = run(d);
+    const RunResult result = run_from_initial(d);
     ScreenRun sr;
     sr.index = k;
     sr.p = p;

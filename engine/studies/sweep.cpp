@@ -4,6 +4,7 @@
 
 #include "engine/analysis/run.hpp"
 #include "engine/framework/errors.hpp"
+#include "engine/studies/initial_equilibrium.hpp"
 #include "engine/studies/run_sharing.hpp"
 
 namespace dydp::engine {
@@ -23,7 +24,7 @@ std::vector<double> objectives_at(const SweepSpec& spec, int index, double p) {
   RunOptions o;
   o.sensitivities = false;
   std::vector<double> psi;
-  for (const auto& obj : run(d, o).objectives) psi.push_back(obj.value);
+  for (const auto& obj : run_from_initial(d, o).objectives) psi.push_back(obj.value);
   return psi;
 }
 
@@ -63,7 +64,7 @@ SweepResult sweep(const SweepSpec& spec) {
     d.set_parameter(index, p);
     // The swept parameter is the one sensitivity direction the sweep needs.
     d.set_sensitivities({index});
-    const RunResult r = run(d);
+    const RunResult r = run_from_initial(d);
     nlohmann::json j;
     for (const auto& obj : r.objectives) {
       j["psi"].push_back(obj.value);
