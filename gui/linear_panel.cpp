@@ -85,8 +85,9 @@ QString mode_name(const engine::Mode& mode) {
     if (state == "pitch") return QObject::tr("body pitch");
     if (state == "roll") return QObject::tr("body roll");
     if (state == "yaw") return QObject::tr("body yaw");
-    if (contains(state, "wheel") || contains(state, "arm") || contains(state, "link") || contains(state, "knuckle"))
-      return QObject::tr("wheel hop (%1)").arg(q(first));
+    // The wheel's own coordinate, or that of the link carrying it (lower control arm, trailing link).
+    for (const char* part : {"wheel", "arm", "link", "knuckle", "lca", "uca", "trailing"})
+      if (contains(state, part)) return QObject::tr("wheel hop (%1)").arg(q(first));
   }
   if (contains(block, "damper")) return QObject::tr("damper hydraulics (%1)").arg(q(block));
   if (contains(block, "wk") || contains(block, "filter")) return QObject::tr("filter (%1)").arg(q(block));
@@ -164,8 +165,9 @@ LinearPanel::LinearPanel(SceneController* controller, RunWorker* worker, QWidget
   split->addWidget(left);
   split->addWidget(table_);
   split->addWidget(chart_);
-  split->setStretchFactor(1, 2);
-  split->setStretchFactor(2, 3);
+  split->setStretchFactor(1, 3);
+  split->setStretchFactor(2, 4);
+  split->setSizes({330, 760, 900});
   layout->addWidget(split);
 
   connect(modes_button_, &QPushButton::clicked, this, [this] { compute_modes(); });

@@ -53,9 +53,9 @@ struct LinearResult {
 /// Throws InputError (a bad signal or hold) or SolverError (no equilibrium in reach).
 LinearResult compute_linear(engine::Diagram& d, const LinearRequest& request);
 
-/// A name for a mode from its dominant states: "body heave", "body pitch", "body roll", "wheel
-/// hop (car.q.z_wheel)", "damper hydraulics (corner_fl.damper)", "filter (wk)", or the first
-/// dominant state.
+/// A name for a mode from the state that dominates it most: "body heave", "body pitch", "body
+/// roll" (a multibody model's z, pitch, roll), "wheel hop (car.q.lca_fr)" (a wheel's coordinate or
+/// its link's), "damper hydraulics (corner_fl.damper)", "filter (wk)", else that state's label.
 QString mode_name(const engine::Mode& mode);
 
 class LinearPanel : public QWidget {

@@ -75,7 +75,7 @@ class GuiLinear : public QObject {
     QVERIFY(table->rowCount() >= 10);
     // The first rows: the Wk filter's lowest pole (0.4 Hz), then the body's heave, pitch and roll
     // (docs/studies.md: 1.227, 1.329, 1.772 Hz).
-    int body = 0;
+    int body = 0, hop = 0;
     for (int row = 0; row < table->rowCount(); ++row) {
       const double f = table->item(row, 0)->data(Qt::UserRole).toDouble();
       const double zeta = table->item(row, 1)->data(Qt::UserRole).toDouble();
@@ -93,8 +93,13 @@ class GuiLinear : public QObject {
         ++body;
       }
       QVERIFY(table->item(row, 3)->text().startsWith(QString::fromStdString(expected[row].dominant.front().first)));
+      if (name.startsWith("wheel hop")) {
+        QVERIFY2(f > 10.0 && f < 25.0, qPrintable(name));
+        ++hop;
+      }
     }
     QCOMPARE(body, 3);
+    QCOMPARE(hop, 4);  // one per corner: the rear trailing links, the front lower arms
     QVERIFY(panel->message().contains("eigenvalues below 1e-3"));
     QVERIFY(w.status_text().contains("modes of"));
   }
