@@ -4,12 +4,14 @@
 // closed form's (the tyre carries both masses), the initial sensitivities are dx*/dp (the
 // closed form's d(tyre force)/d(ms) = g), and the sensitivities at later times of a run driven
 // by a road sine are those of whole runs each started from its own equilibrium (central
-// differences, a step study). Bad `initial:` values are refused at their line.
+// differences, a step study); the sedan on a still 4-poster stays still from its equilibrium.
+// Bad `initial:` values are refused at their line.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "engine/analysis/run.hpp"
@@ -137,6 +139,52 @@ TEST(InitialEquilibrium, InitialSensitivitiesAreTheEquilibriumsDerivatives) {
     EXPECT_NEAR(r.tangent(k, 1, wheel), dkt, 1e-9 * dkt) << "t = " << r.t[k];
     EXPECT_NEAR(r.tangent(k, 2, wheel), -kG / kKt, 1e-9 * kG / kKt) << "t = " << r.t[k];
   }
+}
+
+/// `text` with `from` replaced by `to` (once; a failure when `from` is not there).
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
+TEST(InitialEquilibrium, SedanOnAStillRigStaysStill) {
+  // scenarios/fourposter_comfort.yaml with the pads still (no sine, no noise), 1 s, from its
+  // equilibrium: the dampers' oil (conserved: a family of equilibria) kept where the settling
+  // motion leaves it, every state derivative zero there.
+  const std::string source = std::string(DYDP_SOURCE_DIR) + "/scenarios/fourposter_comfort.yaml";
+  std::ifstream in(source);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text = replaced(text, "time: {start: 0.0, stop: 20.0, output_step: 0.01}",
+                  "time: {start: 0.0, stop: 1.0, output_step: 0.01}\ninitial: equilibrium");
+  text = replaced(text, "amplitude_fl: 0.01, amplitude_fr: 0.01, amplitude_rl: 0.01, amplitude_rr: 0.01",
+                  "amplitude_fl: 0.0, amplitude_fr: 0.0, amplitude_rl: 0.0, amplitude_rr: 0.0");
+  text = replaced(text, "noise_rms: 0.0005", "noise_rms: 0.0");
+  text = replaced(text, "{file: subsystems/corner_rig.yaml}",
+                  "{file: " + std::string(DYDP_SOURCE_DIR) + "/scenarios/subsystems/corner_rig.yaml}");
+  for (int k = 0; k < 2; ++k) text = replaced(text, "window: [2.0, 20.0]", "window: [0.2, 1.0]");
+  const std::string path = (std::filesystem::temp_directory_path() / "dydp_initial_sedan_still.yaml").string();
+  std::ofstream(path) << text;
+  Diagram d = load_scene(path);
+  const auto eq = start_at_equilibrium(d);
+  ASSERT_TRUE(eq.has_value());
+  EXPECT_GT(eq->rank_deficiency, 0);  // the oil of the dampers, the free coordinates
+  Evaluator e(d, false);
+  std::vector<double> xdot(d.num_states);
+  e.derivatives(d.time.start, d.start.x.data(), xdot.data());
+  const std::vector<double> nominal = state_nominals(d);
+  for (int i = 0; i < d.num_states; ++i) EXPECT_LT(std::fabs(xdot[i]) / nominal[i], 1e-9) << state_label(d, i);
+  const RunResult r = run(d);
+  const std::vector<double> moved = largest_change(r);
+  std::printf("sedan, still rig, 1 s from its equilibrium: body acceleration moves %.3g m/s^2, roll %.3g rad, "
+              "the front-left tyre force %.3g N, its rebound pressure %.3g Pa\n",
+              moved[r.signal_index("car.body_acc_z")], moved[r.signal_index("car.roll")],
+              moved[r.signal_index("corner_fl.tyre.force")], moved[r.signal_index("corner_fl.damper.p_rebound")]);
+  EXPECT_LT(moved[r.signal_index("car.body_acc_z")], 1e-9);
+  EXPECT_LT(std::fabs(r.value(0, r.signal_index("car.body_acc_z"))), 1e-9);
+  EXPECT_LT(moved[r.signal_index("car.roll")], 1e-12);
+  EXPECT_LT(moved[r.signal_index("corner_fl.tyre.force")], 1e-6);
+  EXPECT_LT(moved[r.signal_index("corner_fl.damper.p_rebound")], 1e-3);
 }
 
 /// A signal's value at output k of a whole run with scene parameter `p` set to `value`, started
