@@ -19,6 +19,7 @@
 #include "engine/evaluation/evaluator.hpp"
 #include "engine/framework/errors.hpp"
 #include "engine/studies/initial_equilibrium.hpp"
+#include "engine/studies/sweep.hpp"
 #include "tests/engine/scene_error_test.hpp"
 
 namespace dydp::engine {
@@ -253,6 +254,39 @@ TEST(InitialEquilibrium, SensitivitiesAreCentralDifferencesOfRunsFromTheirOwnEqu
               r.tangent(30, 2, force), wrong.tangent(30, 2, force));
   EXPECT_GT(std::fabs(wrong.tangent(30, 2, force) - fd), 0.1 * std::fabs(fd));
   EXPECT_LT(std::fabs(r.tangent(30, 2, force) - fd), 1e-4 * std::fabs(fd));
+}
+
+TEST(InitialEquilibrium, SweepPointsAndTheirDifferencesStartFromTheirOwnEquilibria) {
+  // The sine-road quarter car with the rms of its body acceleration over [0.1, 0.6] s, swept
+  // over ms: each point's d(psi)/d(ms) against the sweep's own central differences (each run
+  // of them from its own equilibrium) at h = 4 and 2 kg.
+  std::ifstream in(quarter_car("sweep", kSineRoad, "initial: {state: equilibrium, hold: {rzd.y: 0.0}}", 0.6));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text = replaced(text, "  body_az: {type: math.demux, width: 3, indices: [2]}",
+                  "  body_az: {type: math.demux, width: 3, indices: [2]}\n  rms: {type: objective.rms, window: [0.1, 0.6]}");
+  text = replaced(text, "  - car.body_acc -> body_az.u", "  - car.body_acc -> body_az.u\n  - body_az.y -> rms.in");
+  text = replaced(text, "outputs: [body_az.y,", "outputs: [rms, body_az.y,");
+  const std::string path = (std::filesystem::temp_directory_path() / "dydp_initial_sweep_rms.yaml").string();
+  std::ofstream(path) << text;
+  SweepSpec spec;
+  spec.scene = path;
+  spec.parameter = "ms";
+  spec.low = 340.0;
+  spec.high = 360.0;
+  spec.points = 2;
+  spec.fd_steps = {4.0, 2.0};
+  spec.threads = 1;
+  const SweepResult r = sweep(spec);
+  ASSERT_EQ(r.points.size(), 2u);
+  for (const SweepPoint& pt : r.points) {
+    ASSERT_EQ(pt.dpsi.size(), 1u);
+    const double e1 = std::fabs(pt.fd[0][0] - pt.dpsi[0]), e2 = std::fabs(pt.fd[1][0] - pt.dpsi[0]);
+    std::printf("sweep ms = %g: psi %.10g, d(psi)/d(ms) %.10g, |D - S| at 4 and 2 kg: %.3g %.3g (ratio %.2f)\n", pt.p,
+                pt.psi[0], pt.dpsi[0], e1, e2, e1 / e2);
+    EXPECT_GT(e1 / e2, 3.0) << pt.p;
+    EXPECT_LT(e1 / e2, 5.0) << pt.p;
+    EXPECT_LT(e2, 1e-3 * std::fabs(pt.dpsi[0])) << pt.p;
+  }
 }
 
 class InitialSectionErrors : public test::SceneErrorTest {
