@@ -188,8 +188,8 @@ SceneDocument parse_scene(const std::string& text, const std::string& file) {
     } else if (key == "solver") {
       doc.solver = r.fields(v, key);
     } else if (key == "initial") {
-      YAML::Emitter text;
-      text << v;
+      YAML::Emitter text;  // on one line, as the Scene tab shows and edits it
+      text << YAML::Flow << v;
       doc.initial = text.c_str();
     } else if (key == "parameters") {
       if (!v.IsMap()) r.fail(v, key, "expected a mapping");

@@ -14,7 +14,7 @@ RunResult run(const Diagram& d, const RunOptions& options) {
   // would start a sweep's point from another point's equilibrium, its sensitivities wrong.
   if (!d.start.x.empty() && !d.start_is_current())
     throw std::logic_error("the run's start state was computed for other parameter values or another start time");
-  if (d.initial.equilibrium && d.start.x.empty())
+  if (d.initial.equilibrium && d.num_states > 0 && d.start.x.empty())
     throw std::logic_error("the scene starts at its equilibrium (initial: equilibrium) but none was computed: "
                            "run it through engine/studies/initial_equilibrium.hpp");
   RunResult r = d.solver.method == "rk4"      ? run_rk4(d, options)

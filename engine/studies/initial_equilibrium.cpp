@@ -5,7 +5,8 @@
 namespace dydp::engine {
 
 std::optional<Equilibrium> start_at_equilibrium(Diagram& d) {
-  if (!d.initial.equilibrium || d.start_is_current()) return std::nullopt;
+  // A diagram without states starts where it is.
+  if (!d.initial.equilibrium || d.num_states == 0 || d.start_is_current()) return std::nullopt;
   d.start = StartState{};  // Newton starts from the blocks' own initial states
   EquilibriumOptions o;
   o.time = d.time.start;

@@ -1,8 +1,9 @@
 // The "Modes & FRF" tab: the sedan on its 4-poster (scenarios/fourposter_comfort.yaml, the pads
 // held still) opened in the window, its modes computed on the worker thread and tabled, and the
 // pad-to-body frequency response plotted; each compared with the engine's own modes and
-// frequency_response computed here, apart from the GUI. A scene with no equilibrium in reach
-// (a constant force on a mass without spring) shows the error and the window goes on working.
+// frequency_response computed here, apart from the GUI. A scene's initial state shown and edited
+// in the Scene tab, the run starting where it says. A scene with no equilibrium in reach (a
+// constant force on a mass without spring) shows the error and the window goes on working.
 #include <QChart>
 #include <QChartView>
 #include <QLineSeries>
@@ -154,6 +155,54 @@ class GuiLinear : public QObject {
     QVERIFY2(error.contains("car.no_such_signal"), qPrintable(error));
     QCOMPARE(panel->error(), error);
     QCOMPARE(series(chart, 0)->count(), 40);
+  }
+
+  void initial_state_is_edited_in_the_scene_tab() {
+    QTemporaryDir dir;
+    const QString path = dir.filePath("still.yaml");
+    QFile f(path);
+    QVERIFY(f.open(QIODevice::WriteOnly));
+    f.write(R"(scene: still
+time: {stop: 1.0, output_step: 0.1}
+initial: {state: equilibrium, hold: {f.y: 2.0}}
+blocks:
+  m: {type: mass_spring_damper, k: 4.0, c: 1.0}
+  f: {type: source.constant, value: 1.0}
+connections: [f.y -> m.f]
+outputs: [m.x]
+)");
+    f.close();
+    MainWindow w;
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QVERIFY(w.open_file(path, true));
+    auto* field = w.scene_panel()->findChild<QLineEdit*>("scene_initial");
+    QVERIFY(field);
+    QTRY_COMPARE(field->text(), QString("{state: equilibrium, hold: {f.y: 2.0}}"));  // refreshed queued
+    // The run starts at the equilibrium with f.y held at 2 N: x = 0.5 m from t = 0 (then the
+    // force is 1 N and the mass moves toward 0.25 m).
+    QSignalSpy run(&w, &MainWindow::run_ended);
+    QVERIFY(w.start_run());
+    QVERIFY(run.wait(60000));
+    RunOutcome outcome = run.takeFirst().at(0).value<RunOutcome>();
+    QVERIFY(outcome.status == RunOutcome::Status::finished);
+    QCOMPARE(outcome.result->value(0, 0), 0.5);
+    // Edited in the Scene tab: `declared` starts at the block's x0 = 0.
+    field->setText("declared");
+    QMetaObject::invokeMethod(field, "editingFinished");
+    QCOMPARE(QString::fromStdString(w.controller()->document().initial), QString("declared"));
+    QVERIFY(w.start_run());
+    QVERIFY(run.wait(60000));
+    outcome = run.takeFirst().at(0).value<RunOutcome>();
+    QVERIFY(outcome.status == RunOutcome::Status::finished);
+    QCOMPARE(outcome.result->value(0, 0), 0.0);
+    // Not YAML: refused, the document unchanged.
+    field->setText("{state: [");
+    QMetaObject::invokeMethod(field, "editingFinished");
+    QCOMPARE(QString::fromStdString(w.controller()->document().initial), QString("declared"));
+    // Undo brings the equilibrium back.
+    w.controller()->undo_stack()->undo();
+    QCOMPARE(QString::fromStdString(w.controller()->document().initial), QString("{state: equilibrium, hold: {f.y: 2.0}}"));
   }
 
   void scene_without_equilibrium_shows_the_error() {
