@@ -3,6 +3,7 @@
 #include <QChart>
 #include <QLegend>
 #include <QLineSeries>
+#include <QLogValueAxis>
 #include <QValueAxis>
 #include <algorithm>
 #include <cmath>
@@ -22,6 +23,28 @@ std::pair<double, double> padded_range(double lo, double hi) {
   return {lo - pad, hi + pad};
 }
 
+/// The same on a log axis (lo, hi > 0): 5 % of the decades either side.
+std::pair<double, double> padded_log_range(double lo, double hi) {
+  if (!(lo > 0) || !std::isfinite(lo) || !std::isfinite(hi)) return {0.1, 10.0};
+  if (!(hi > lo)) return {lo / 10, lo * 10};
+  const double pad = std::pow(hi / lo, 0.05);
+  return {lo / pad, hi * pad};
+}
+
+QAbstractAxis* make_axis(bool log, const QString& title) {
+  if (log) {
+    auto* a = new QLogValueAxis;
+    a->setBase(10.0);
+    a->setLabelFormat("%g");
+    a->setMinorTickCount(8);
+    a->setTitleText(title);
+    return a;
+  }
+  auto* a = new QValueAxis;
+  a->setTitleText(title);
+  return a;
+}
+
 }  // namespace
 
 std::vector<QString> units_of(const std::vector<Curve>& curves) {
@@ -32,7 +55,7 @@ std::vector<QString> units_of(const std::vector<Curve>& curves) {
 }
 
 void draw_curves(QChart* chart, const QString& title, const std::vector<Curve>& curves,
-                 const std::function<QString(const QString& unit)>& axis_title) {
+                 const std::function<QString(const QString& unit)>& axis_title, const ChartAxes& axes) {
   chart->removeAllSeries();
   for (QAbstractAxis* a : chart->axes()) {
     chart->removeAxis(a);
@@ -42,15 +65,16 @@ void draw_curves(QChart* chart, const QString& title, const std::vector<Curve>& 
   if (curves.empty() || !curves.front().t || curves.front().t->empty()) return;
   const std::vector<QString> units = units_of(curves);
   const bool per_unit = units.size() <= kAxesPerChart;
-  auto* x = new QValueAxis;
-  x->setTitleText("t [s]");
+  QAbstractAxis* x = make_axis(axes.log_x, axes.x_title);
   chart->addAxis(x, Qt::AlignBottom);
   // One y axis per unit (left, right), or one for all.
-  std::vector<QValueAxis*> y_axes;
+  std::vector<QAbstractAxis*> y_axes;
+  std::vector<bool> log_y;
   std::vector<double> lo, hi;
   for (size_t k = 0; k < (per_unit ? units.size() : 1); ++k) {
-    auto* y = new QValueAxis;
-    y->setTitleText(per_unit ? axis_title(units[k]) : QObject::tr("value (units in the legend)"));
+    log_y.push_back(k == 0 && axes.log_first_y);
+    QAbstractAxis* y =
+        make_axis(log_y.back(), per_unit ? axis_title(units[k]) : QObject::tr("value (units in the legend)"));
     chart->addAxis(y, k == 0 ? Qt::AlignLeft : Qt::AlignRight);
     y_axes.push_back(y);
     lo.push_back(INFINITY);
@@ -65,6 +89,7 @@ void draw_curves(QChart* chart, const QString& title, const std::vector<Curve>& 
     QList<QPointF> points;
     points.reserve(static_cast<qsizetype>(c.t->size()));
     for (size_t k = 0; k < c.t->size() && k < c.v.size(); ++k) {
+      if ((log_y[axis] && !(c.v[k] > 0)) || (axes.log_x && !((*c.t)[k] > 0))) continue;  // not on a log axis
       points.append({(*c.t)[k], c.v[k]});
       lo[axis] = std::min(lo[axis], c.v[k]);
       hi[axis] = std::max(hi[axis], c.v[k]);
@@ -86,7 +111,7 @@ void draw_curves(QChart* chart, const QString& title, const std::vector<Curve>& 
   }
   x->setRange(t0, t1);
   for (size_t k = 0; k < y_axes.size(); ++k) {
-    const auto [a, b] = padded_range(lo[k], hi[k]);
+    const auto [a, b] = log_y[k] ? padded_log_range(lo[k], hi[k]) : padded_range(lo[k], hi[k]);
     y_axes[k]->setRange(a, b);
   }
   chart->legend()->setVisible(true);

@@ -1,7 +1,9 @@
 // dydp-gui: edit and run dydp scenes as block diagrams.
-//   dydp-gui [SCENE] [--run] [--plot SIGNAL,SIGNAL] [--screenshot FILE.png]
-// With --screenshot the window is shown, the scene run (with --run) and the window saved as an
-// image, then the program exits (used by scripts/gui_screenshot.sh).
+//   dydp-gui [SCENE] [--run] [--plot SIGNAL,SIGNAL] [--modes] [--frf] [--hold SIGNAL=VALUE,...]
+//            [--screenshot FILE.png]
+// With --screenshot the window is shown, the scene run (with --run) or its modes and FRF computed
+// (--modes, --frf) and the window saved as an image, then the program exits (used by
+// scripts/gui_screenshot.sh).
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QScreen>
@@ -22,7 +24,10 @@ int main(int argc, char** argv) {
   const QCommandLineOption size_option("size", "window size WxH", "WxH", "1600x1000");
   const QCommandLineOption plot_option("plot", "after the run, plot these logged signals overlaid (comma-separated)",
                                        "SIGNALS");
-  cli.addOptions({run_option, shot_option, size_option, plot_option});
+  const QCommandLineOption modes_option("modes", "compute the modes about the equilibrium once opened");
+  const QCommandLineOption frf_option("frf", "compute the frequency response (the default input and output) once opened");
+  const QCommandLineOption hold_option("hold", "signals the equilibrium holds, SIGNAL=VALUE,...", "HOLDS");
+  cli.addOptions({run_option, shot_option, size_option, plot_option, modes_option, frf_option, hold_option});
   cli.process(app);
 
   dydp::gui::MainWindow window;
@@ -64,6 +69,25 @@ int main(int argc, char** argv) {
       const QString why = window.results()->plot_signals(chosen);
       if (!why.isEmpty()) std::fprintf(stderr, "--plot: %s\n", why.toUtf8().constData());
     });
+  if (cli.isSet(hold_option)) window.linear()->hold_field()->setText(cli.value(hold_option));
+  if (cli.isSet(modes_option) || cli.isSet(frf_option)) {
+    // The modes first, then the FRF, then the screenshot (without --run).
+    const bool modes = cli.isSet(modes_option), frf = cli.isSet(frf_option);
+    QTimer::singleShot(200, &window, [&window, modes, frf] {
+      if (!(modes ? window.start_modes() : window.start_frf()))
+        std::fprintf(stderr, "%s\n", window.linear()->message().toUtf8().constData());
+    });
+    QObject::connect(window.linear(), &dydp::gui::LinearPanel::analysis_ended, &window,
+                     [&, modes, frf, done = 0](const QString& error) mutable {
+                       if (!error.isEmpty()) std::fprintf(stderr, "%s\n", error.toUtf8().constData());
+                       ++done;
+                       if (modes && frf && done == 1) {
+                         QTimer::singleShot(0, &window, [&window] { window.start_frf(); });
+                         return;
+                       }
+                       if (!shot.isEmpty() && !cli.isSet(run_option)) take_shot();
+                     });
+  }
   if (cli.isSet(run_option)) {
     QTimer::singleShot(200, &window, [&] {
       if (!window.start_run()) {
@@ -73,7 +97,7 @@ int main(int argc, char** argv) {
     });
     if (!shot.isEmpty())
       QObject::connect(&window, &dydp::gui::MainWindow::run_ended, &window, [&] { take_shot(); });
-  } else if (!shot.isEmpty()) {
+  } else if (!shot.isEmpty() && !cli.isSet(modes_option) && !cli.isSet(frf_option)) {
     take_shot();
   }
   return app.exec();

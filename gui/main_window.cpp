@@ -45,9 +45,13 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   addDockWidget(Qt::RightDockWidgetArea, right_dock);
 
   results_ = new ResultsPanel;
+  linear_ = new LinearPanel(&controller_, &worker_);
+  bottom_tabs_ = new QTabWidget;
+  bottom_tabs_->addTab(results_, tr("Run results"));
+  bottom_tabs_->addTab(linear_, tr("Modes && FRF"));
   auto* results_dock = new QDockWidget(tr("Results"));
   results_dock->setObjectName("results");
-  results_dock->setWidget(results_);
+  results_dock->setWidget(bottom_tabs_);
   addDockWidget(Qt::BottomDockWidgetArea, results_dock);
 
   // Actions.
@@ -103,6 +107,9 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   run_action_ = run_menu->addAction(tr("&Run"), QKeySequence(Qt::Key_F5), this, [this] { start_run(); });
   cancel_action_ = run_menu->addAction(tr("&Cancel"), QKeySequence(Qt::Key_Escape), this, [this] { worker_.cancel(); });
   cancel_action_->setEnabled(false);
+  run_menu->addSeparator();
+  run_menu->addAction(tr("&Modes about the equilibrium"), QKeySequence(Qt::CTRL | Qt::Key_M), this, [this] { start_modes(); });
+  run_menu->addAction(tr("&Frequency response"), this, [this] { start_frf(); });
   for (QAction* a : {act_new, act_open, act_save}) tools->addAction(a);
   tools->addSeparator();
   tools->addAction(undo);
@@ -167,11 +174,31 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   });
   connect(&worker_, &RunWorker::progress, this, [this](double f) { progress_->setValue(static_cast<int>(f * 1000)); });
   connect(&worker_, &RunWorker::finished, this, &MainWindow::run_finished);
+  connect(linear_, &LinearPanel::analysis_ended, this, [this](const QString& error) {
+    run_action_->setEnabled(true);
+    status(error.isEmpty() ? linear_->message() : tr("analysis failed: %1").arg(error));
+  });
   resize(1500, 950);
   update_title();
 }
 
 void MainWindow::status(const QString& text) { status_label_->setText(text); }
+
+bool MainWindow::start_modes() {
+  bottom_tabs_->setCurrentWidget(linear_);
+  if (!linear_->compute_modes()) return status(linear_->message()), false;
+  run_action_->setEnabled(false);
+  status(linear_->message());
+  return true;
+}
+
+bool MainWindow::start_frf() {
+  bottom_tabs_->setCurrentWidget(linear_);
+  if (!linear_->compute_frf()) return status(linear_->message()), false;
+  run_action_->setEnabled(false);
+  status(linear_->message());
+  return true;
+}
 
 void MainWindow::update_breadcrumb(const QStringList& level) {
   QString text = level.isEmpty() ? tr("<b>scene</b>") : QString("<a href=\"0\">%1</a>").arg(tr("scene"));
@@ -199,6 +226,7 @@ bool MainWindow::open_file(const QString& path, bool quiet) {
     return false;
   }
   results_->forget_runs();
+  linear_->refresh_signals();
   canvas_->fit_all();
   status(tr("opened %1").arg(path));
   return true;
@@ -267,6 +295,7 @@ void MainWindow::run_finished(const RunOutcome& outcome) {
   switch (outcome.status) {
     case RunOutcome::Status::finished: {
       progress_->setValue(1000);
+      bottom_tabs_->setCurrentWidget(results_);
       results_->show_result(outcome.result, outcome.diagram);
       std::map<std::string, QString> notes;
       for (const auto& o : outcome.result->objectives) notes[o.name] = QString("ψ = %1").arg(o.value, 0, 'g', 6);

@@ -1,5 +1,6 @@
 // The main window: palette (left), canvas (centre), block and scene panels (right), results
-// (bottom); File, Edit and Run actions; runs go to a worker thread with progress and cancel.
+// (bottom, beside the modes table and FRF plot); File, Edit and Run actions; runs and the linear
+// analyses go to a worker thread, runs with progress and cancel.
 #pragma once
 
 #include <QAction>
@@ -7,8 +8,10 @@
 #include <QLineEdit>
 #include <QMainWindow>
 #include <QProgressBar>
+#include <QTabWidget>
 
 #include "gui/canvas.hpp"
+#include "gui/linear_panel.hpp"
 #include "gui/palette.hpp"
 #include "gui/property_editor.hpp"
 #include "gui/results_panel.hpp"
@@ -30,6 +33,11 @@ class MainWindow : public QMainWindow {
   PropertyEditor* property_editor() { return properties_; }
   ScenePanel* scene_panel() { return scene_panel_; }
   ResultsPanel* results() { return results_; }
+  /// The modes table and FRF plot of the open scene (the "Modes & FRF" tab beside the results).
+  LinearPanel* linear() { return linear_; }
+  /// Shows the "Modes & FRF" tab and starts the modes (or the FRF); false when it did not start.
+  bool start_modes();
+  bool start_frf();
   QLabel* breadcrumb() { return breadcrumb_; }
   QLineEdit* find_field() { return find_; }
   /// The message shown in the status bar.
@@ -65,6 +73,8 @@ class MainWindow : public QMainWindow {
   PropertyEditor* properties_;
   ScenePanel* scene_panel_;
   ResultsPanel* results_;
+  LinearPanel* linear_;
+  QTabWidget* bottom_tabs_;
   QProgressBar* progress_;
   QAction* run_action_;
   QAction* cancel_action_;

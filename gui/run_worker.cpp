@@ -5,6 +5,7 @@
 
 #include "engine/analysis/run.hpp"
 #include "engine/framework/errors.hpp"
+#include "engine/studies/initial_equilibrium.hpp"
 
 namespace dydp::gui {
 namespace {
@@ -26,7 +27,7 @@ RunWorker::~RunWorker() {
 
 bool RunWorker::start(engine::Diagram d, bool sensitivities) {
   if (thread_) return false;
-  auto diagram = std::make_shared<const engine::Diagram>(std::move(d));
+  auto diagram = std::make_shared<engine::Diagram>(std::move(d));
   auto cancel = std::make_shared<std::atomic<bool>>(false);
   cancel_ = cancel;
   thread_ = QThread::create([this, diagram, cancel, sensitivities] {
@@ -45,7 +46,8 @@ bool RunWorker::start(engine::Diagram d, bool sensitivities) {
       }
     };
     try {
-      outcome.result = std::make_shared<const engine::RunResult>(engine::run(*diagram, options));
+      // `initial: equilibrium`: the start is found here, off the GUI thread, before the run.
+      outcome.result = std::make_shared<const engine::RunResult>(engine::run_from_initial(*diagram, options));
       outcome.status = RunOutcome::Status::finished;
     } catch (const RunCancelled&) {
       outcome.status = RunOutcome::Status::cancelled;
@@ -61,11 +63,39 @@ bool RunWorker::start(engine::Diagram d, bool sensitivities) {
   return true;
 }
 
-void RunWorker::deliver(RunOutcome outcome) {
+bool RunWorker::start_job(std::function<void()> job) {
+  if (thread_) return false;
+  thread_ = QThread::create([this, job = std::move(job)] {
+    QString message;
+    try {
+      job();
+    } catch (const std::exception& e) {
+      message = QString::fromStdString(e.what());
+      if (message.isEmpty()) message = tr("failed");
+    } catch (...) {
+      message = tr("failed");
+    }
+    QMetaObject::invokeMethod(
+        this,
+        [this, message] {
+          end_thread();
+          emit job_finished(message);
+        },
+        Qt::QueuedConnection);
+  });
+  thread_->start();
+  return true;
+}
+
+void RunWorker::end_thread() {
   thread_->wait();
   delete thread_;
   thread_ = nullptr;
   cancel_.reset();
+}
+
+void RunWorker::deliver(RunOutcome outcome) {
+  end_thread();
   emit finished(outcome);
 }
 

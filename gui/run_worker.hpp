@@ -7,6 +7,7 @@
 #include <QString>
 #include <QThread>
 #include <atomic>
+#include <functional>
 #include <memory>
 
 #include "engine/analysis/run_result.hpp"
@@ -32,6 +33,10 @@ class RunWorker : public QObject {
 
   /// Starts running d; false when a run is already going on.
   bool start(engine::Diagram d, bool sensitivities = true);
+  /// Runs `job` on the worker thread instead of a run (the linear analyses, gui/linear_panel.hpp);
+  /// job_finished(message) follows on the owner's thread: "" when the job returned, else what it
+  /// threw. False when a run or a job is going on. The job must not touch widgets.
+  bool start_job(std::function<void()> job);
   /// Asks the running solver to stop at its next output time; finished() follows (cancelled).
   void cancel();
   bool running() const { return thread_ != nullptr; }
@@ -41,9 +46,11 @@ class RunWorker : public QObject {
  signals:
   void progress(double fraction);
   void finished(const dydp::gui::RunOutcome& outcome);
+  void job_finished(const QString& message);
 
  private:
   void deliver(RunOutcome outcome);
+  void end_thread();
   QThread* thread_ = nullptr;
   std::shared_ptr<std::atomic<bool>> cancel_;
 };

@@ -10,6 +10,7 @@
 #include <QRegularExpression>
 #include <QTemporaryFile>
 #include <QUndoCommand>
+#include <yaml-cpp/yaml.h>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -430,6 +431,21 @@ QString SceneController::set_solver(const QString& key, const QString& text) {
   SceneDocument after = doc_;
   set_field(after.solver, s(key), s(text.trimmed()));
   commit(tr("Set solver.%1").arg(key), std::move(after));
+  return {};
+}
+
+QString SceneController::set_initial(const QString& text) {
+  const std::string t = s(text.trimmed());
+  if (!t.empty()) {
+    try {
+      YAML::Load(t);
+    } catch (const YAML::Exception& e) {
+      return tr("initial: not YAML: %1").arg(QString::fromStdString(e.msg));
+    }
+  }
+  SceneDocument after = doc_;
+  after.initial = t;
+  commit(tr("Set initial"), std::move(after));
   return {};
 }
 

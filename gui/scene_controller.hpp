@@ -69,6 +69,9 @@ class SceneController : public QObject {
   void set_output(const QString& ref, bool logged);
   QString set_time(const QString& key, const QString& text);
   QString set_solver(const QString& key, const QString& text);
+  /// The `initial:` section as YAML text (`equilibrium`, `{state: equilibrium, hold: {rig.zdot: 0}}`;
+  /// empty removes it); refused when it is not YAML (the engine checks the rest when run).
+  QString set_initial(const QString& text);
   void set_scene_info(const QString& name, const QString& description);
   QString add_scene_parameter(const QString& name, const QString& value);
   /// Replaces scene parameter `name` by p; a new name is carried to $refs and sensitivities.

@@ -102,6 +102,9 @@ struct SceneDocument {
   std::string description;
   Fields time;
   Fields solver;
+  /// The `initial:` section (where runs start: `equilibrium`, or `{state, hold}`) as YAML text,
+  /// kept on save as it was read; empty when the scene has none. The GUI does not edit it.
+  std::string initial;
   std::vector<DocParameter> parameters;
   std::vector<std::string> sensitivities;
   /// The `directions:` list (directions named by block parameters, docs/scenes.md) as YAML text,

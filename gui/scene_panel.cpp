@@ -72,6 +72,20 @@ ScenePanel::ScenePanel(SceneController* controller, QWidget* parent)
   }
   layout->addWidget(solver_box);
 
+  // Where runs start (docs/scenes.md, "Where a run starts"), as YAML on one line.
+  auto* initial_box = new QGroupBox(tr("Initial state"));
+  auto* initial_form = new QFormLayout(initial_box);
+  initial_ = new QLineEdit;
+  initial_->setObjectName("scene_initial");
+  initial_->setPlaceholderText(tr("declared (or: equilibrium, {state: equilibrium, hold: {SIGNAL: VALUE}})"));
+  initial_->setToolTip(tr("equilibrium: runs start at the static equilibrium at time.start, with the inputs held "
+                          "there and the hold signals at their values"));
+  initial_form->addRow("initial", initial_);
+  connect(initial_, &QLineEdit::editingFinished, this, [this] {
+    if (!refreshing_) report(controller_->set_initial(initial_->text()));
+  });
+  layout->addWidget(initial_box);
+
   auto* param_box = new QGroupBox(tr("Scene parameters (blocks use them as $name)"));
   auto* param_layout = new QVBoxLayout(param_box);
   params_ = new QTableWidget(0, 6);
@@ -148,6 +162,7 @@ void ScenePanel::refresh() {
     const std::string* v = find_field(doc.solver, s(key));
     e->setText(v ? q(*v) : QString());
   }
+  initial_->setText(q(doc.initial));
   const std::string* method = find_field(doc.solver, "method");
   method_->setCurrentText(method ? q(*method) : QString());
   params_->setRowCount(0);

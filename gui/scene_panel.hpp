@@ -34,6 +34,7 @@ class ScenePanel : public QWidget {
   QLineEdit* name_;
   QLineEdit* description_;
   std::map<QString, QLineEdit*> time_, solver_;
+  QLineEdit* initial_;
   QComboBox* method_;
   QTableWidget* params_;
   QLabel* status_;

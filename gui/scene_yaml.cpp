@@ -187,6 +187,10 @@ SceneDocument parse_scene(const std::string& text, const std::string& file) {
       doc.time = r.fields(v, key);
     } else if (key == "solver") {
       doc.solver = r.fields(v, key);
+    } else if (key == "initial") {
+      YAML::Emitter text;  // on one line, as the Scene tab shows and edits it
+      text << YAML::Flow << v;
+      doc.initial = text.c_str();
     } else if (key == "parameters") {
       if (!v.IsMap()) r.fail(v, key, "expected a mapping");
       for (auto p : v) doc.parameters.push_back(read_parameter(r, p.first.Scalar(), p.second));
@@ -245,6 +249,7 @@ std::string write_scene(const SceneDocument& doc) {
   if (!doc.description.empty()) e << YAML::Key << "description" << YAML::Value << doc.description;
   emit_fields(e, "time", doc.time);
   emit_fields(e, "solver", doc.solver);
+  if (!doc.initial.empty()) e << YAML::Key << "initial" << YAML::Value << YAML::Load(doc.initial);
   if (!doc.parameters.empty()) {
     e << YAML::Key << "parameters" << YAML::Value << YAML::BeginMap;
     for (const DocParameter& p : doc.parameters) {

@@ -14,6 +14,7 @@
 #include "engine/analysis/run.hpp"
 #include "engine/framework/diagram.hpp"
 #include "engine/framework/errors.hpp"
+#include "engine/studies/initial_equilibrium.hpp"
 #include "io/output_writer.hpp"
 #include "python/bindings.hpp"
 
@@ -102,7 +103,7 @@ engine::Diagram shadow_of(const Scene& scene) {
   return shadow;
 }
 
-RunArrays run_scene(const Scene& scene, bool sensitivities, const py::object& progress, bool estimate) {
+RunArrays run_scene(Scene& scene, bool sensitivities, const py::object& progress, bool estimate) {
   engine::RunOptions options;
   options.sensitivities = sensitivities;
   if (!progress.is_none()) {
@@ -116,6 +117,7 @@ RunArrays run_scene(const Scene& scene, bool sensitivities, const py::object& pr
   {
     py::gil_scoped_release released;
     const std::lock_guard<std::mutex> turn(*scene.running);
+    engine::start_at_equilibrium(scene.diagram);  // `initial: equilibrium`: its start first (the shadow's too)
     if (estimate) {
       engine::Diagram shadow = shadow_of(scene);
       r = engine::run_with_error_estimate(scene.diagram, shadow, options);

@@ -1,6 +1,7 @@
 // dydp equilibrium, linearize, modes and frf: the analyses about one operating point
 // (engine/linear/), each written as JSON/CSV (and MAT with --format mat) once everything is
 // computed, so a failure leaves nothing half written.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -17,6 +18,7 @@
 #include "engine/linear/frequency_response.hpp"
 #include "engine/linear/modes.hpp"
 #include "engine/linear/signal_lookup.hpp"
+#include "engine/studies/initial_equilibrium.hpp"
 #include "io/files.hpp"
 #include "io/mat_file.hpp"
 
@@ -36,10 +38,21 @@ engine::Diagram load(const LinearArgs& args) {
   return d;
 }
 
+/// The scene's `initial.hold`, then --hold (which replaces the scene's value of the same signal).
+std::vector<std::pair<int, double>> scene_and_option_holds(const engine::Diagram& d, const LinearArgs& args) {
+  std::vector<std::pair<int, double>> held = d.initial.held;
+  for (const auto& [offset, value] : engine::held_signals(d, args.holds, "--hold")) {
+    auto same = std::find_if(held.begin(), held.end(), [o = offset](const auto& h) { return h.first == o; });
+    if (same != held.end()) same->second = value;
+    else held.push_back({offset, value});
+  }
+  return held;
+}
+
 engine::EquilibriumOptions equilibrium_options(const engine::Diagram& d, const LinearArgs& args) {
   engine::EquilibriumOptions o;
   o.time = std::isnan(args.time) ? d.time.start : args.time;
-  o.held = engine::held_signals(d, args.holds, "--hold");
+  o.held = scene_and_option_holds(d, args);
   if (o.time < d.time.start || o.time > d.time.stop)
     throw engine::InputError("--time", 0, engine::format_number(o.time),
                              "outside the scene's time [" + engine::format_number(d.time.start) + ", " +
@@ -176,7 +189,7 @@ int linearize_command(const LinearArgs& args) {
     to.time.stop = args.at;
     engine::RunOptions o;
     o.sensitivities = false;
-    const engine::RunResult r = engine::run(to, o);
+    const engine::RunResult r = engine::run_from_initial(to, o);
     m = engine::linearize(d, args.at, r.final_state, args.inputs, args.outputs, held);
     about = "the run's state at t = " + engine::format_number(args.at) + " s";
   }

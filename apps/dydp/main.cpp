@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
     c->add_option("--out", linear_args.out, "output folder")->capture_default_str();
     c->add_option("--set", linear_args.sets, "override a scene parameter: NAME=VALUE");
     c->add_option("--time", linear_args.time, "hold the inputs at their values at this time [s] (default: the scene's start)");
-    c->add_option("--hold", linear_args.holds, "hold a signal at a value, SIGNAL=VALUE (e.g. rig.zdot=0: the pads still)");
+    c->add_option("--hold", linear_args.holds, "hold a signal at a value, SIGNAL=VALUE (e.g. rig.zdot=0: the pads still); the equilibrium also holds the scene's initial.hold, a --hold of the same signal replacing its value");
     c->add_option("--format", linear_args.format, "csv: the CSV/JSON files; mat: also a MAT v5 file")
         ->check(CLI::IsMember({"csv", "mat"}))->capture_default_str();
     return c;

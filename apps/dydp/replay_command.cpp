@@ -10,6 +10,7 @@
 #include "engine/analysis/error_estimate.hpp"
 #include "engine/analysis/run.hpp"
 #include "engine/framework/errors.hpp"
+#include "engine/studies/initial_equilibrium.hpp"
 #include "engine/studies/recording_validation.hpp"
 #include "io/files.hpp"
 #include "io/mat_outputs.hpp"
@@ -94,6 +95,7 @@ int replay_command(const ReplayArgs& args) {
     worst_lag = std::max(worst_lag, now - due);
   };
   const auto t0 = std::chrono::steady_clock::now();
+  engine::start_at_equilibrium(d);  // `initial: equilibrium`; the shadow run starts there too
   engine::RunResult r;
   if (args.no_estimate) {
     r = engine::run(d, options);

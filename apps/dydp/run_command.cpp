@@ -13,6 +13,7 @@
 #include "engine/analysis/run.hpp"
 #include "engine/framework/errors.hpp"
 #include "engine/framework/numbers.hpp"
+#include "engine/studies/initial_equilibrium.hpp"
 #include "io/mat_outputs.hpp"
 #include "io/output_writer.hpp"
 
@@ -80,6 +81,7 @@ int run_command(const RunArgs& args) {
     std::cerr << "\r" << d.scene_name << ": t = " << std::fixed << std::setprecision(2) << t
               << " s  [" << percent << "%]" << std::flush;
   };
+  engine::start_at_equilibrium(d);  // `initial: equilibrium`; the shadow run starts there too
   engine::RunResult r;
   if (args.no_estimate) {
     r = engine::run(d, options);

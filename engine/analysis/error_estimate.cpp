@@ -94,6 +94,8 @@ void estimate_from_shadow(RunResult& run, const RunResult& shadow, const ShadowP
 RunResult run_with_error_estimate(const Diagram& d, Diagram& shadow, const RunOptions& options) {
   const ShadowPlan plan = shadow_plan(d.solver, d.time);
   shadow.solver = plan.solver;
+  // The same start as the run (`initial: equilibrium`: the same scene, the same parameters).
+  if (shadow.start.x.empty()) shadow.start = d.start;
   RunOptions quiet;
   quiet.sensitivities = options.sensitivities;
   quiet.difference_quotient_sensitivities = options.difference_quotient_sensitivities;

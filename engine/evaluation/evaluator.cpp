@@ -96,6 +96,10 @@ Seeds Evaluator::seeds_for(const Node& n, int index, int nd, ConstDirView dx, bo
 }
 
 void Evaluator::initial_state(double t0, double* x0) {
+  if (!d_.start.x.empty()) {  // a start given from outside (`initial: equilibrium`)
+    std::copy(d_.start.x.begin(), d_.start.x.end(), x0);
+    return;
+  }
   std::fill(x0, x0 + d_.num_states, 0.0);
   for (size_t i = 0; i < d_.nodes.size(); ++i) {
     const Node& n = d_.nodes[i];
@@ -108,6 +112,19 @@ void Evaluator::initial_state_tangent(double t0, const double* x0, DirView dx0) 
   for (int dir = 0; dir < ns_; ++dir)
     std::fill(dx0.data + dir * dx0.ld, dx0.data + dir * dx0.ld + d_.num_states, 0.0);
   if (ns_ == 0) return;
+  if (!d_.start.x.empty()) {  // its dx0/dp, the column of each direction
+    const int nx = d_.num_states;
+    for (int dir = 0; dir < ns_; ++dir) {
+      const auto& cols = d_.start.parameters;
+      const auto c = std::find(cols.begin(), cols.end(), d_.sensitivities[dir]);
+      if (c == cols.end())
+        throw std::logic_error("the run's start state has no derivative for direction " +
+                               d_.parameters[d_.sensitivities[dir]].name);
+      const double* from = d_.start.dx_dp.data() + static_cast<size_t>(c - cols.begin()) * nx;
+      std::copy(from, from + nx, dx0.data + dir * dx0.ld);
+    }
+    return;
+  }
   dsig_.assign(static_cast<size_t>(d_.num_signals) * ns_, 0.0);
   for (size_t i = 0; i < d_.nodes.size(); ++i) {
     const Node& n = d_.nodes[i];

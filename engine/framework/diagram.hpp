@@ -51,6 +51,30 @@ struct SolverSpec {
   bool refresh_local_jacobians = true;
 };
 
+/// Where a run starts (`initial:` in a scene, docs/scenes.md).
+struct InitialSpec {
+  /// `initial: equilibrium`: from the static equilibrium at time.start with the inputs held at
+  /// their values there (engine/studies/initial_equilibrium.hpp computes it before each run);
+  /// false: from the blocks' own initial states.
+  bool equilibrium = false;
+  /// `initial.hold`: signals the equilibrium holds at other values (a pad's rate at 0), resolved
+  /// to (signal offset, value); `hold_names` as written, one per entry (a port's every element).
+  std::vector<std::pair<int, double>> held;
+  std::vector<std::string> hold_names;
+  int line = 0;  ///< of `initial:` (0: not written)
+};
+
+/// A run's start given from outside the blocks' initial_state: x0 and dx0/dp, set by
+/// engine/studies/initial_equilibrium.hpp for `initial: equilibrium` and valid only for the
+/// block parameters and start time it was computed at (engine/analysis/run.cpp refuses a stale one).
+struct StartState {
+  std::vector<double> x;                 ///< empty: the blocks' own initial states
+  std::vector<int> parameters;           ///< the scene parameter of each column of dx_dp
+  std::vector<double> dx_dp;             ///< column c at dx_dp[c * num_states ...]
+  double t = 0.0;                        ///< the time.start it was computed at
+  std::vector<double> block_parameters;  ///< every kept block's p, in node order, when computed
+};
+
 struct SceneParameter {
   std::string name;
   double value = 0.0;
@@ -117,6 +141,8 @@ class Diagram {
   SolverSpec solver;
   std::vector<SceneParameter> parameters;
   std::vector<int> sensitivities;      ///< indices into parameters: the directions
+  InitialSpec initial;
+  StartState start;
   std::vector<Node> nodes;             ///< kept blocks, in scene order
   /// Output evaluation, in dependency order: one step per group of a block's outputs that read
   /// the same inputs (state-only outputs first).
@@ -147,6 +173,10 @@ class Diagram {
   double parameter_seed(const Node& n, int j, int d) const {
     return n.p_scene[j] >= 0 && n.p_scene[j] == sensitivities[d] ? 1.0 : 0.0;
   }
+  /// Every kept block's parameter values, in node order (what `start` was computed for).
+  std::vector<double> block_parameter_values() const;
+  /// Whether `start` is set and was computed for the present block parameters and time.start.
+  bool start_is_current() const;
   /// All breakpoints of the kept blocks in (t0, t1], sorted, unique.
   std::vector<double> breakpoints(double t0, double t1) const;
 };

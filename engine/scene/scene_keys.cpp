@@ -10,6 +10,7 @@ std::vector<std::string> scene_format_keys() {
   };
   add("time.", kTimeKeys);
   add("solver.", kSolverKeys);
+  add("initial.", kInitialKeys);
   add("parameters.*.", kSceneParameterKeys);
   add("directions.*.", kDirectionKeys);
   return keys;

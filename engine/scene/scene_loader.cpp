@@ -14,6 +14,7 @@
 #include "engine/scene/consistency_checks.hpp"
 #include "engine/scene/duplicate_keys.hpp"
 #include "engine/scene/graph_builder.hpp"
+#include "engine/scene/initial_section.hpp"
 #include "engine/scene/scene_flattener.hpp"
 #include "engine/scene/scene_keys.hpp"
 #include "engine/scene/scene_relations.hpp"
@@ -180,6 +181,7 @@ Diagram load_scene(const std::string& path,
   d.scene_name = root["scene"] ? r.text(root["scene"], "scene") : "scene";
   read_time(r, root["time"], d.time);
   read_solver(r, root["solver"], d.time, d.solver);
+  const InitialSection initial = read_initial_section(root["initial"], path);
   read_parameters(r, root["parameters"], d);
 
   // --set of a direction named by block parameters waits until the blocks are read.
@@ -223,6 +225,7 @@ Diagram load_scene(const std::string& path,
   for (auto item : outputs) flat.request_output(r.text(item, "outputs"), path, line_of(item));
 
   graph.build(d);
+  bind_initial_section(initial, path, d);
   for (const auto& [name, text] : direction_overrides) {
     const int i = d.find_parameter(name);
     if (i < 0)
@@ -305,6 +308,17 @@ void Diagram::set_parameter(int index, double value, bool check_range) {
     for (size_t j = 0; j < n.p.size(); ++j)
       if (n.p_scene[j] == index) n.p[j] = value;
   sp.value = value;
+}
+
+std::vector<double> Diagram::block_parameter_values() const {
+  std::vector<double> out;
+  for (const Node& n : nodes) out.insert(out.end(), n.p.begin(), n.p.end());
+  return out;
+}
+
+bool Diagram::start_is_current() const {
+  return !start.x.empty() && static_cast<int>(start.x.size()) == num_states && start.t == time.start &&
+         start.block_parameters == block_parameter_values();
 }
 
 std::vector<double> Diagram::breakpoints(double t0, double t1) const {

@@ -13,6 +13,7 @@
 
 #include "engine/analysis/run.hpp"
 #include "engine/framework/errors.hpp"
+#include "engine/studies/initial_equilibrium.hpp"
 #include "engine/studies/run_sharing.hpp"
 #include "engine/studies/sobol_points.hpp"
 #include "io/files.hpp"
@@ -199,7 +200,8 @@ ScreenResult screen(const ScreenSpec& spec) {
       d.set_sensitivities(indices);
       return d;
     };
-    const Diagram d = at_point();
+    Diagram d = at_point();
+    start_at_equilibrium(d);  // `initial: equilibrium`; the shadow run starts there too
     RunResult result;
     if (spec.estimate) {
       Diagram shadow = at_point();

@@ -5,6 +5,7 @@
 #include "engine/analysis/error_estimate.hpp"
 #include "engine/analysis/run.hpp"
 #include "engine/framework/errors.hpp"
+#include "engine/studies/initial_equilibrium.hpp"
 #include "engine/studies/run_sharing.hpp"
 
 namespace dydp::engine {
@@ -24,7 +25,7 @@ std::vector<double> objectives_at(const SweepSpec& spec, int index, double p) {
   RunOptions o;
   o.sensitivities = false;
   std::vector<double> psi;
-  for (const auto& obj : run(d, o).objectives) psi.push_back(obj.value);
+  for (const auto& obj : run_from_initial(d, o).objectives) psi.push_back(obj.value);
   return psi;
 }
 
@@ -67,7 +68,8 @@ SweepResult sweep(const SweepSpec& spec) {
       d.set_sensitivities({index});
       return d;
     };
-    const Diagram d = at_point();
+    Diagram d = at_point();
+    start_at_equilibrium(d);  // `initial: equilibrium`; the shadow run starts there too
     RunResult r;
     if (spec.estimate) {
       Diagram shadow = at_point();

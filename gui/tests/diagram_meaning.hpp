@@ -27,6 +27,9 @@ inline std::string diagram_meaning(const engine::Diagram& d) {
     << exact(d.solver.min_step) << " " << d.solver.nominal_scaling << "\n";
   s << "solver newton_coefficient " << exact(d.solver.newton_coefficient) << " max_order " << d.solver.max_order
     << " refresh_local_jacobians " << d.solver.refresh_local_jacobians << "\n";
+  s << "initial " << (d.initial.equilibrium ? "equilibrium" : "declared");
+  for (const auto& [offset, value] : d.initial.held) s << " hold " << offset << "=" << exact(value);
+  s << "\n";
   for (const auto& p : d.parameters)
     s << "parameter " << p.name << " = " << exact(p.value) << " [" << p.unit << "] in [" << exact(p.lower)
       << ", " << exact(p.upper) << "]\n";

@@ -67,6 +67,7 @@ scene: every_key
 description: "every key of the scene format"
 time: {start: 0.5, stop: 3.0, output_step: 0.05}
 solver: {method: bdf, rtol: 1.0e-5, atol: 1.0e-7, step: 0.001, max_steps: 20000, min_step: 1.0e-11, sens_error_test: false, nominal_scaling: false, newton_coefficient: 0.25, refresh_local_jacobians: false, max_order: 3}
+initial: {state: equilibrium, hold: {wave.y: 0.5}}
 parameters:
   gain: {value: 2.5, unit: "1", range: [0.0, 10.0], description: forcing gain}
 directions:
@@ -196,6 +197,8 @@ outputs: [lag.y, sum, peak, energy]
     f.close();
     const std::string original = diagram_meaning(dydp::engine::load_scene(path.toStdString()));
     QVERIFY(original.find("solver newton_coefficient 0.25 max_order 3 refresh_local_jacobians 0\n") != std::string::npos);
+    QVERIFY(original.find("initial equilibrium hold ") != std::string::npos);
+    QVERIFY(original.find("=0.5\n") != std::string::npos);
     SceneController c;
     c.open(path);
     std::string text;

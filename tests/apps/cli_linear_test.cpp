@@ -142,5 +142,26 @@ TEST_F(Cli, ASceneWithoutEquilibriumIsASolverFailure) {
   EXPECT_FALSE(fs::exists(dir_ / "none"));
 }
 
+TEST_F(Cli, SceneHoldsAreTheEquilibriumsAndAHoldOptionReplacesOne) {
+  // The sedan with `initial.hold` in the scene (its runs still start from the declared state).
+  const std::string time = "time: {start: 0.0, stop: 20.0, output_step: 0.01}";
+  const std::string held = write("held.yaml", replaced(scene_copy_text(sedan()), time,
+                                                       time + "\ninitial: {state: declared, hold: {rig.zdot: 0.0}}"));
+  const Result from_scene = dydp("equilibrium " + quote(held) + " --out " + quote((dir_ / "a").string()));
+  ASSERT_EQ(from_scene.status, 0) << from_scene.err;
+  const Result from_option = dydp("equilibrium " + quote(sedan()) + " --hold rig.zdot=0 --out " + quote((dir_ / "b").string()));
+  ASSERT_EQ(from_option.status, 0) << from_option.err;
+  const json a = read_json(dir_ / "a/equilibrium.json"), b = read_json(dir_ / "b/equilibrium.json");
+  EXPECT_EQ(a["held"], b["held"]);
+  EXPECT_EQ(a["state"], b["state"]);
+  // --hold of the same signal replaces the scene's value: the pads held rising at 0.01 m/s.
+  const Result replaced = dydp("equilibrium " + quote(held) + " --hold rig.zdot=0.01 --out " + quote((dir_ / "c").string()));
+  ASSERT_EQ(replaced.status, 0) << replaced.err;
+  const json c = read_json(dir_ / "c/equilibrium.json");
+  EXPECT_EQ(c["held"].size(), 4u);
+  for (const auto& [name, value] : c["held"].items()) EXPECT_EQ(value.get<double>(), 0.01) << name;
+  EXPECT_NE(c["state"], a["state"]);
+}
+
 }  // namespace
 }  // namespace dydp::test

@@ -59,6 +59,38 @@ outputs: [src.y]
   expect_refused("run " + quote(scene), scene + ":3: solver.step: must be positive");
 }
 
+TEST_F(CliValidation, BadInitialSectionExitsTwo) {
+  const std::string typo = write("typo.yaml", R"(scene: t
+time: {stop: 1.0, output_step: 0.1}
+initial: equilibrum
+blocks:
+  src: {type: source.sine}
+outputs: [src.y]
+)");
+  expect_refused("run " + quote(typo), typo + ":3: initial: unknown value 'equilibrum' (equilibrium, declared)");
+  const std::string hold = write("hold.yaml", R"(scene: t
+time: {stop: 1.0, output_step: 0.1}
+initial:
+  state: equilibrium
+  hold: {src.x: 0.0}
+blocks:
+  src: {type: source.sine}
+outputs: [src.y]
+)");
+  expect_refused("run " + quote(hold), hold + ":5: initial.hold.src.x: block src has no output x (its outputs: y)");
+  // A constant force on a mass without spring: no equilibrium, refused before anything is run.
+  const std::string falling = write("falling.yaml", R"(scene: t
+time: {stop: 1.0, output_step: 0.1}
+initial: equilibrium
+blocks:
+  m: {type: mass_spring_damper, k: 0.0}
+  f: {type: source.constant, value: 1.0}
+connections: [f.y -> m.f]
+outputs: [m.x]
+)");
+  expect_refused("run " + quote(falling), falling + ":3: initial: equilibrium: t = 0 s: block m: no equilibrium in reach");
+}
+
 TEST_F(CliValidation, SceneThatIsAFolderExitsTwoNamingIt) {
   const fs::path folder = dir_ / "scenes";
   fs::create_directories(folder);

@@ -19,7 +19,7 @@ ALLOWED = {
     "engine/analysis": ["engine/framework", "engine/evaluation"],
     "engine/linear": ["engine/framework", "engine/evaluation", "engine/analysis"],
     "io": ["engine/framework", "engine/analysis/run_result.hpp"],
-    "engine/studies": ["engine/framework", "engine/scene", "engine/evaluation", "engine/analysis", "io"],
+    "engine/studies": ["engine/framework", "engine/scene", "engine/evaluation", "engine/analysis", "engine/linear", "io"],
     "blocks": ["engine/framework", "io", "generated_models", "symbolic"],
     "python": ["engine", "io", "blocks"],
     "gui": ["engine", "io", "blocks"],

@@ -1,0 +1,35 @@
+#include "engine/studies/initial_equilibrium.hpp"
+
+#include "engine/framework/errors.hpp"
+
+namespace dydp::engine {
+
+std::optional<Equilibrium> start_at_equilibrium(Diagram& d) {
+  // A diagram without states starts where it is.
+  if (!d.initial.equilibrium || d.num_states == 0 || d.start_is_current()) return std::nullopt;
+  d.start = StartState{};  // Newton starts from the blocks' own initial states
+  EquilibriumOptions o;
+  o.time = d.time.start;
+  o.held = d.initial.held;
+  Equilibrium eq;
+  try {
+    eq = find_equilibrium(d, o);
+  } catch (const SolverError& e) {
+    throw InputError(d.file, d.initial.line, "initial", std::string("equilibrium: ") + e.what());
+  }
+  StartState s;
+  s.x = eq.x;
+  s.parameters = eq.parameters;
+  s.dx_dp.assign(eq.dx_dp.data(), eq.dx_dp.data() + eq.dx_dp.size());  // column-major: column c at c * n
+  s.t = d.time.start;
+  s.block_parameters = d.block_parameter_values();
+  d.start = std::move(s);
+  return eq;
+}
+
+RunResult run_from_initial(Diagram& d, const RunOptions& options) {
+  start_at_equilibrium(d);
+  return run(d, options);
+}
+
+}  // namespace dydp::engine

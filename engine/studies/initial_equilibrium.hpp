@@ -1,0 +1,26 @@
+// A scene that starts at its static equilibrium (`initial: equilibrium`, docs/scenes.md): the
+// equilibrium at time.start with the inputs held there (and `initial.hold`), found by
+// engine/linear/equilibrium.hpp, made the diagram's start state with dx*/dp as the initial
+// sensitivities, so that a run's d(signal)/dp is that of a run starting at the equilibrium of
+// the perturbed parameters. engine/analysis cannot include engine/linear (docs/architecture.md):
+// every caller of run() for such a scene goes through here (the commands, the studies, the GUI's
+// worker, the Python module).
+#pragma once
+
+#include <optional>
+
+#include "engine/analysis/run.hpp"
+#include "engine/linear/equilibrium.hpp"
+
+namespace dydp::engine {
+
+/// For a scene with `initial: equilibrium` whose start is not current (never computed, or the
+/// parameters or time.start changed since): finds the equilibrium and sets d.start; returns it.
+/// Nothing for other scenes (nullopt). A scene with no equilibrium in reach is an InputError at
+/// the line of `initial:` carrying the Newton's residual.
+std::optional<Equilibrium> start_at_equilibrium(Diagram& d);
+
+/// start_at_equilibrium(d), then run(d, options).
+RunResult run_from_initial(Diagram& d, const RunOptions& options = {});
+
+}  // namespace dydp::engine
