@@ -22,6 +22,9 @@ if [ -z "$corpus" ]; then
   temporary_corpus=true
 fi
 mkdir -p "$corpus" "$artifacts"
+# absolute: cli_fuzz runs the program in a folder of its own (its working directory)
+corpus=$(cd "$corpus" && pwd)
+artifacts=$(cd "$artifacts" && pwd)
 seeds=$(mktemp -d)
 log=$(mktemp)
 trap 'rm -rf "$seeds" "$log"; if $temporary_corpus; then rm -rf "$corpus"; fi' EXIT
