@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fuzzes the scene loader, the CSV reader and the RPC III reader with libFuzzer under ASan+UBSan (docs/fuzzing.md).
+# Fuzzes the input readers, the command line and a bounded run of a scene with libFuzzer under ASan+UBSan (docs/fuzzing.md).
 #   bash scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     default: 60 s, every target
 # Builds the targets in the sanitize preset's build (build/sanitize, clang-14; scripts/setup.sh
 # installs clang-14 and libclang-rt-14-dev) and runs each with scripts/fuzz_run.sh, keeping its
@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(scene_loader_fuzz csv_fuzz rpc3_fuzz)
+[ ${#targets[@]} -gt 0 ] || targets=(scene_loader_fuzz csv_fuzz rpc3_fuzz mbs_model_fuzz eqs_fuzz cli_fuzz scene_run_fuzz)
 
 build=build/sanitize
 cmake --preset sanitize >/dev/null

@@ -56,6 +56,9 @@ class Reader {
   }
 
  private:
+  static constexpr std::size_t kMaxElements = 100000;
+  std::size_t elements_ = 0;  // of the arrays declared so far
+
   Context& ctx() { return *model_.context; }
 
   [[noreturn]] void fail(const std::string& message) const { throw ParseError(file_, line_, message); }
@@ -97,6 +100,12 @@ class Reader {
     if (values_.count(array_name) || ctx().find_array(array_name)) fail("'" + array_name + "' is already defined");
     const std::size_t size = integer("the array size");
     if (size == 0) fail("array '" + array_name + "' must have at least one element");
+    // A bound on what the list's inputs and parameters may take (each element is a symbol):
+    // without it `input q 12936409836691885623` asked for the memory of that many symbols.
+    if (size > kMaxElements - elements_)
+      fail("array '" + array_name + "' of " + std::to_string(size) + " elements: the inputs and parameters of a list have at most " +
+           std::to_string(kMaxElements) + " elements in all");
+    elements_ += size;
     if (!model_.list->assignments().empty()) fail("declare inputs and parameters before the equations");
     try {
       ctx().add_array(array_name, size, kind);

@@ -16,6 +16,7 @@
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -33,6 +34,15 @@
 
 namespace dydp::engine {
 namespace {
+
+/// CVODES' name of a return flag. CVodeGetReturnFlagName mallocs the name; the caller frees it
+/// (found by scene_run_fuzz: every failed run leaked it).
+std::string flag_name(int flag) {
+  char* name = CVodeGetReturnFlagName(flag);
+  std::string s = name ? name : "unknown flag";
+  std::free(name);
+  return s;
+}
 
 /// Steps between CVODES' linear set-ups when blocks refresh their own Jacobian blocks.
 constexpr int kLocalRefreshSetupSteps = 5;
@@ -229,7 +239,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   S.ns = ns;
   auto check = [&](int flag, const char* call) {
     if (flag < 0)
-      throw SolverError(t0, "", std::string(call) + " failed: " + CVodeGetReturnFlagName(flag) +
+      throw SolverError(t0, "", std::string(call) + " failed: " + flag_name(flag) +
                                     (P.cvodes_message.empty() ? "" : " (" + P.cvodes_message + ")"));
   };
   check(SUNContext_Create(nullptr, &S.ctx), "SUNContext_Create");
@@ -394,7 +404,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
              "CVode failed: CV_TOO_MUCH_WORK (" + std::to_string(d.solver.max_steps) +
                  " steps taken before reaching the next output time " + format_number(target) + " s)");
       const int flag = CVode(S.mem, target, S.y, &reached, CV_ONE_STEP);
-      if (flag < 0) fail(flag, reached, std::string("CVode failed: ") + CVodeGetReturnFlagName(flag));
+      if (flag < 0) fail(flag, reached, std::string("CVode failed: ") + flag_name(flag));
       if (nx + nq > 0 && CVodeGetEstLocalErrors(S.mem, local_errors) == CV_SUCCESS &&
           CVodeGetErrWeights(S.mem, weights) == CV_SUCCESS)
         limiters.add_step(NV_DATA_S(local_errors), NV_DATA_S(weights));

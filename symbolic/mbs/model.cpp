@@ -53,6 +53,13 @@ class Loader {
     }
   }
 
+  bool boolean(const YAML::Node& node, const std::string& field) const {
+    bool v = false;
+    if (!node.IsScalar()) fail(node, field, "expected true or false");
+    if (!YAML::convert<bool>::decode(node, v)) fail(node, field, "expected true or false, got '" + node.Scalar() + "'");
+    return v;
+  }
+
   std::string text(const YAML::Node& node, const std::string& field) const {
     if (!node.IsScalar()) fail(node, field, "expected a name");
     return node.Scalar();
@@ -194,7 +201,7 @@ class Loader {
           check_keys(kv.second, field, {"value", "fold", "unit"});
           if (!kv.second["value"]) fail(kv.second, field, "missing value");
           p.value = number(kv.second["value"], field + ".value");
-          if (kv.second["fold"]) p.symbolic = !kv.second["fold"].as<bool>();
+          if (kv.second["fold"]) p.symbolic = !boolean(kv.second["fold"], field + ".fold");
           if (kv.second["unit"]) p.unit = text(kv.second["unit"], field + ".unit");
         } else {
           p.value = number(kv.second, field);
@@ -268,7 +275,7 @@ class Loader {
         }
         joint.parent = parent_joint;
         if (k == 0) joint.offset = offset;
-        if (j["driven"]) joint.driven = j["driven"].as<bool>();
+        if (j["driven"]) joint.driven = boolean(j["driven"], jf + ".driven");
         if (j["initial"]) joint.initial = number(j["initial"], jf + ".initial");
         m_.joints.push_back(joint);
         parent_joint = static_cast<int>(m_.joints.size()) - 1;

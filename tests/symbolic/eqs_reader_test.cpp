@@ -65,6 +65,9 @@ TEST(EqsReader, ReportsFileLineAndMessage) {
       {"input q x\n", 1, "array size"},
       {"input q 2\nA = q[0]*q[1] )\noutput A\n", 2, "unexpected ')'"},
       {"input q 2\nA = q[0]*q[1]\noutput A\ntangent r\n", 4, "not an input"},
+      // found by eqs_fuzz: a size of 1.3e19 ran out of memory, 2.9e6 took a minute
+      {"input q 12936409836691885623\nA = q[0]\noutput A\n", 1, "at most 100000 elements in all"},
+      {"input q 60000\nparam k 40001\nA = q[0]\noutput A\n", 2, "at most 100000 elements in all"},
   };
   for (const BadInput& c : cases) {
     try {

@@ -232,5 +232,59 @@ TEST(DifferenceQuotient, ApproximatesTheExactSensitivities) {
                 1e-4 * std::fabs(exact.objectives[0].sensitivity[j]));
 }
 
+// The tangent pass skips a block whose seeds are all zero and whose inputs come from outputs with
+// zero tangents (evaluator.cpp). Here the second gain has no seeds of its own and reads the first
+// gain's output, which lies in the signal array just before the sine source's output (blocks in
+// scene order: body, first gain, source, second gain), a signal whose tangent is zero: the
+// skip must look at the very signal read, not at its neighbour. g2.y = -2 * 3 * x, so its
+// sensitivities are -6 times the closed form's dx/dp (found alive by scripts/mutate.sh: reading
+// the neighbour's flag passed every other test).
+TEST(SignalChain, AGainReadingAGainBesideASourceCarriesTheSensitivities) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("dydp_msd_chain_test_" + std::to_string(::getpid()) + ".yaml");
+  std::ofstream(path) << R"(scene: msd_chain
+time: {start: 0.0, stop: 3.0, output_step: 0.01}
+solver: {method: bdf, rtol: 1.0e-10, atol: 1.0e-12}
+parameters:
+  mass: {value: 1.5, unit: kg}
+  stiffness: {value: 40.0, unit: N/m}
+  damping: {value: 1.2, unit: N s/m}
+sensitivities: [mass, stiffness, damping]
+blocks:
+  body: {type: mass_spring_damper, m: $mass, k: $stiffness, c: $damping, x0: 0.05, v0: 0.1}
+  g1: {type: math.gain, k: 3.0}
+  force: {type: source.sine, amplitude: 2.0, frequency: 0.8}
+  g2: {type: math.gain, k: -2.0}
+connections:
+  - force.y -> body.f
+  - body.x -> g1.u
+  - g1.y -> g2.u
+outputs: [g2.y]
+)";
+  const Diagram d = load_scene(path.string());
+  std::filesystem::remove(path);
+  const RunResult r = run(d);
+  const int iy = r.signal_index("g2.y");
+  ASSERT_GE(iy, 0);
+  ASSERT_EQ(r.sensitivity_names, (std::vector<std::string>{"mass", "stiffness", "damping"}));
+  std::vector<double> y, y_ref;
+  for (size_t k = 0; k < r.t.size(); ++k) {
+    y.push_back(r.value(static_cast<int>(k), iy));
+    y_ref.push_back(-6.0 * test::msd_position(params(), r.t[k]));
+  }
+  EXPECT_LT(grid_error(y, y_ref), 1e-6);
+  for (int j = 0; j < 3; ++j) {
+    std::vector<double> dy, dy_ref;
+    for (size_t k = 0; k < r.t.size(); ++k) {
+      dy.push_back(r.tangent(static_cast<int>(k), j, iy));
+      const double t = r.t[k];
+      dy_ref.push_back(-6.0 * test::complex_step(
+          [t](const test::MsdParams<std::complex<double>>& p) { return test::msd_position(p, t); },
+          params(), j));
+    }
+    EXPECT_LT(grid_error(dy, dy_ref), 1e-6) << "direction " << r.sensitivity_names[j];
+  }
+}
+
 }  // namespace
 }  // namespace dydp::engine

@@ -108,6 +108,21 @@ TEST(ModelLoader, ErrorsNameFileLineAndField) {
   EXPECT_EQ(error_of(kBase), "");
 }
 
+// A flag (a parameter's fold, a joint's driven) that is not a boolean is an error at its line,
+// not a yaml-cpp conversion exception (found by mbs_model_fuzz: `fold: treu` ended dydp-gen with
+// an uncaught YAML::TypedBadConversion).
+TEST(ModelLoader, FlagsThatAreNotBooleansAreErrors) {
+  const std::string body = "ground: {}\nbodies:\n  - name: arm\n    joints: [{name: q1, type: Rz";
+  EXPECT_EQ(error_of("model: tiny\nparameters:\n  l: {value: 0.5, fold: treu}\n" + body + "}]\n    mass: 1.0\n"),
+            "tiny.mbs.yaml:3: parameters.l.fold: expected true or false, got 'treu'");
+  EXPECT_EQ(error_of("model: tiny\nparameters:\n  l: {value: 0.5, fold: [1]}\n" + body + "}]\n    mass: 1.0\n"),
+            "tiny.mbs.yaml:3: parameters.l.fold: expected true or false");
+  EXPECT_EQ(error_of("model: tiny\n" + body + ",\n                driven: 2}]\n    mass: 1.0\n"),
+            "tiny.mbs.yaml:6: bodies.arm.joints[0].driven: expected true or false, got '2'");
+  // the booleans YAML spells are still read
+  EXPECT_EQ(error_of("model: tiny\nparameters:\n  l: {value: 0.5, fold: false}\n" + body + ", driven: yes}]\n    mass: 1.0\n"), "");
+}
+
 TEST(ModelLoader, ReadsTheNewFeatures) {
   const Model m = parse_model(kBase + R"(  - name: b2
     parent: arm
