@@ -20,6 +20,7 @@
 #include "engine/framework/block.hpp"
 #include "engine/framework/diagram.hpp"
 #include "engine/framework/errors.hpp"
+#include "engine/studies/initial_equilibrium.hpp"
 #include "tests/fuzz/fuzz_input_file.hpp"
 
 namespace {
@@ -76,7 +77,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   bound(d);
   try {
-    const dydp::engine::RunResult r = dydp::engine::run(d);
+    // `initial: equilibrium`: its start first, as every command runs a scene
+    const dydp::engine::RunResult r = dydp::engine::run_from_initial(d);
     const size_t samples = r.t.size();
     const size_t signals = r.signal_names.size();
     if (r.values.size() != samples * signals) __builtin_trap();
