@@ -173,13 +173,17 @@ Pose solve_pose(const GeneratedModel& g, const std::vector<double>& p, const Pos
   const Eigen::VectorXd dz = lu.solve(rhs);
   pose.sensors_rate = S_held_rate + S_free * dz;
 
-  // With respect to the parameters: the held coordinates and the targets stay.
-  e.parameter_derivatives(q, parameters);
+  // With respect to the parameters: the held coordinates and the targets stay. (No blocks of
+  // zero-column matrices: Eigen offsets their null data pointer.)
   const int np = static_cast<int>(parameters.size());
-  Eigen::MatrixXd rhs_p(m + nt, np);
-  rhs_p.topRows(m) = -e.h_p;
-  for (int t = 0; t < nt; ++t) rhs_p.row(m + t) = -e.S_p.row(spec.targets[t].sensor);
-  pose.sensors_dp = e.S_p + S_free * lu.solve(rhs_p);
+  pose.sensors_dp.setZero(k, np);
+  if (np > 0) {
+    e.parameter_derivatives(q, parameters);
+    Eigen::MatrixXd rhs_p(m + nt, np);
+    rhs_p.topRows(m) = -e.h_p;
+    for (int t = 0; t < nt; ++t) rhs_p.row(m + t) = -e.S_p.row(spec.targets[t].sensor);
+    pose.sensors_dp = e.S_p + S_free * lu.solve(rhs_p);
+  }
   pose.q = q;
   pose.sensors = e.S;
   return pose;
