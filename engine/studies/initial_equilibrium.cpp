@@ -1,5 +1,6 @@
 #include "engine/studies/initial_equilibrium.hpp"
 
+#include "engine/analysis/error_estimate.hpp"
 #include "engine/framework/errors.hpp"
 
 namespace dydp::engine {
@@ -30,6 +31,14 @@ std::optional<Equilibrium> start_at_equilibrium(Diagram& d) {
 RunResult run_from_initial(Diagram& d, const RunOptions& options) {
   start_at_equilibrium(d);
   return run(d, options);
+}
+
+RunResult run_study_point(const std::function<Diagram()>& make, bool estimate) {
+  Diagram d = make();
+  start_at_equilibrium(d);
+  if (!estimate) return run(d);
+  Diagram shadow = make();
+  return run_with_error_estimate(d, shadow, RunOptions{});
 }
 
 }  // namespace dydp::engine

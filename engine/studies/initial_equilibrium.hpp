@@ -7,6 +7,7 @@
 // worker, the Python module).
 #pragma once
 
+#include <functional>
 #include <optional>
 
 #include "engine/analysis/run.hpp"
@@ -22,5 +23,10 @@ std::optional<Equilibrium> start_at_equilibrium(Diagram& d);
 
 /// start_at_equilibrium(d), then run(d, options).
 RunResult run_from_initial(Diagram& d, const RunOptions& options = {});
+
+/// A study's run of the diagram `make` builds (a point of a sweep or a screening study): from
+/// its initial state or equilibrium, and with `estimate` its error estimated by a shadow run of
+/// a second diagram from `make` (engine/analysis/error_estimate.hpp) that starts where it does.
+RunResult run_study_point(const std::function<Diagram()>& make, bool estimate);
 
 }  // namespace dydp::engine

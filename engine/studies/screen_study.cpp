@@ -6,8 +6,6 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-
-#include "engine/analysis/error_estimate.hpp"
 #include <set>
 #include <sstream>
 
@@ -200,15 +198,7 @@ ScreenResult screen(const ScreenSpec& spec) {
       d.set_sensitivities(indices);
       return d;
     };
-    Diagram d = at_point();
-    start_at_equilibrium(d);  // `initial: equilibrium`; the shadow run starts there too
-    RunResult result;
-    if (spec.estimate) {
-      Diagram shadow = at_point();
-      result = run_with_error_estimate(d, shadow, RunOptions{});
-    } else {
-      result = run(d);
-    }
+    const RunResult result = run_study_point(at_point, spec.estimate);
     ScreenRun sr;
     sr.index = k;
     sr.p = p;

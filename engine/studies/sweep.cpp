@@ -2,7 +2,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "engine/analysis/error_estimate.hpp"
 #include "engine/analysis/run.hpp"
 #include "engine/framework/errors.hpp"
 #include "engine/studies/initial_equilibrium.hpp"
@@ -68,15 +67,7 @@ SweepResult sweep(const SweepSpec& spec) {
       d.set_sensitivities({index});
       return d;
     };
-    Diagram d = at_point();
-    start_at_equilibrium(d);  // `initial: equilibrium`; the shadow run starts there too
-    RunResult r;
-    if (spec.estimate) {
-      Diagram shadow = at_point();
-      r = run_with_error_estimate(d, shadow, RunOptions{});
-    } else {
-      r = run(d);
-    }
+    const RunResult r = run_study_point(at_point, spec.estimate);
     nlohmann::json j;
     const ErrorEstimate& e = r.stats.error_estimate;
     if (e.estimated)
