@@ -27,14 +27,16 @@ std::vector<std::string> split(const std::string& line) {
 
 void write_run_mat(const std::string& path, const engine::Diagram& d, const engine::RunResult& r,
                    const JsonDocuments& extra) {
-  const size_t n = r.t.size(), nsig = r.signal_names.size(), ns = r.sensitivity_names.size();
+  const size_t n = r.t.size(), nsig = r.signal_names.size();
+  const size_t ns = r.signal_sensitivities ? r.sensitivity_names.size() : 0;  // adjoint: the objectives' only
   std::vector<std::string> names = {"t"}, units = {"s"}, signal_units;
   for (size_t i = 0; i < nsig; ++i) {
     names.push_back(r.signal_names[i]);
     signal_units.push_back(d.signal_unit(d.logged[i].offset));
     units.push_back(signal_units.back());
   }
-  for (const auto& p : r.sensitivity_names) {
+  for (size_t dir = 0; dir < ns; ++dir) {
+    const std::string& p = r.sensitivity_names[dir];
     const std::string& punit = d.parameters[d.find_parameter(p)].unit;
     for (size_t i = 0; i < nsig; ++i) {
       names.push_back("d(" + r.signal_names[i] + ")/d(" + p + ")");

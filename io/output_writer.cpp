@@ -17,14 +17,15 @@ namespace {
 void write_signals_header(std::ostream& out, const engine::RunResult& r) {
   out << "t";
   for (const auto& s : r.signal_names) out << ',' << s;
-  for (const auto& p : r.sensitivity_names)
-    for (const auto& s : r.signal_names) out << ",d(" << s << ")/d(" << p << ')';
+  if (r.signal_sensitivities)
+    for (const auto& p : r.sensitivity_names)
+      for (const auto& s : r.signal_names) out << ",d(" << s << ")/d(" << p << ')';
   out << '\n';
 }
 
 void write_signals_row(std::ostream& out, const engine::RunResult& r, size_t k) {
   const int nsig = r.num_signals();
-  const int ns = static_cast<int>(r.sensitivity_names.size());
+  const int ns = r.signal_sensitivities ? static_cast<int>(r.sensitivity_names.size()) : 0;
   out << r.t[k];
   for (int i = 0; i < nsig; ++i) out << ',' << r.value(static_cast<int>(k), i);
   for (int d = 0; d < ns; ++d)
@@ -91,6 +92,26 @@ std::string run_json(const engine::Diagram& d, const engine::RunResult& r) {
                 {"worst_sensitivity", s.error_estimate.worst_sensitivity},
                 {"how", s.error_estimate.how},
                 {"cpu_seconds", s.error_estimate.cpu_seconds}};
+  // an adjoint run: its checkpoints, backward steps and memory (a forward run has no such key)
+  nlohmann::ordered_json adjoint = nullptr;
+  if (s.adjoint.used) {
+    const engine::AdjointStats& a = s.adjoint;
+    adjoint = {{"objectives", a.objectives},
+               {"segments", a.segments},
+               {"checkpoints", a.checkpoints},
+               {"steps_between_checkpoints", a.steps_between_checkpoints},
+               {"forward_steps", a.forward_steps},
+               {"replay_steps", a.replay_steps},
+               {"replays_differing", a.replays_differing},
+               {"backward_steps", a.backward_steps},
+               {"backward_rhs_evaluations", a.backward_rhs_evals},
+               {"backward_quadrature_evaluations", a.backward_quadrature_evals},
+               {"backward_jacobian_evaluations", a.backward_jac_evals},
+               {"checkpoint_bytes", a.checkpoint_bytes},
+               {"peak_rss_bytes", a.peak_rss_bytes},
+               {"forward_cpu_seconds", a.forward_cpu_seconds},
+               {"backward_cpu_seconds", a.backward_cpu_seconds}};
+  }
   nlohmann::ordered_json j = {
       {"scene", d.scene_name},
       {"file", d.file},
@@ -125,6 +146,7 @@ std::string run_json(const engine::Diagram& d, const engine::RunResult& r) {
       {"pruned_blocks", d.pruned},
       {"warnings", s.warnings},
   };
+  if (s.adjoint.used) j["adjoint"] = adjoint;
   return j.dump(2) + "\n";
 }
 

@@ -11,6 +11,7 @@ packages=(
   gnuplot-nox liborocos-kdl-dev
   qt6-base-dev qt6-charts-dev libqt6opengl6-dev libgl-dev
   libboost-dev libopenmpi-dev openmpi-bin
+  libzip-dev libxml2-utils
   libmatio-dev pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-matplotlib
 )
 

@@ -20,6 +20,9 @@ struct RunArgs {
   bool no_estimate = false;  ///< --no-estimate: no shadow run, no error estimate
   bool report = false;
   std::string format = "csv";     ///< csv | mat (also run.mat)
+  /// --adjoint: the objectives' gradients for every declared parameter and direction by the
+  /// adjoint method; the signals without sensitivities.
+  bool adjoint = false;
 };
 
 struct SweepArgs {
@@ -69,6 +72,7 @@ struct ScreenArgs {
   bool resume = false;
   int threads = 0;                ///< --threads: 0 one per core (one per rank under MPI)
   bool no_estimate = false;       ///< --no-estimate: no shadow runs
+  bool adjoint = false;           ///< --adjoint: the gradients by the adjoint method
 };
 
 /// equilibrium, linearize, modes, frf: the analyses about one operating point.
@@ -99,6 +103,14 @@ struct KcArgs {
   std::string format = "csv";
 };
 
+/// fmu: the scene (or an FMU description naming one) as an FMI 3.0 FMU.
+struct FmuArgs {
+  std::string scene;
+  std::string out;
+  std::string kind = "both";  ///< me | cs | both
+};
+
+int fmu_command(const FmuArgs& args);
 int run_command(const RunArgs& args);
 int kc_command(const KcArgs& args);
 int equilibrium_command(const LinearArgs& args);

@@ -41,6 +41,9 @@ int main(int argc, char** argv) {
   run->add_option("--set", run_args.sets, "override a scene parameter: NAME=VALUE");
   run->add_flag("--no-sens", run_args.no_sens, "run without sensitivities");
   run->add_flag("--no-estimate", run_args.no_estimate, "no shadow run: no estimate of the run's error");
+  run->add_flag("--adjoint", run_args.adjoint,
+                "the objectives' gradients for every declared parameter and direction by the adjoint method "
+                "(one backward run; the signals without sensitivities)");
   run->add_flag("--report", run_args.report, "also write plots (gnuplot) and report.md");
   add_solver_options(run, run_args.solver);
   run->add_option("--format", run_args.format, "csv: the CSV/JSON files; mat: also run.mat (MAT v5)")
@@ -100,6 +103,8 @@ int main(int argc, char** argv) {
   screen->add_option("--set", screen_args.sets, "override a scene parameter: NAME=VALUE");
   screen->add_flag("--report", screen_args.report, "also write plots (gnuplot) and report.md");
   screen->add_flag("--no-estimate", screen_args.no_estimate, "no shadow runs: the runs' error is not estimated (half the CPU)");
+  screen->add_flag("--adjoint", screen_args.adjoint,
+                   "each run's gradients by the adjoint method (one backward run, whatever the number of parameters)");
   screen->add_flag("--resume", screen_args.resume, "keep the runs recorded in OUT/runs/ and run only the missing ones");
   screen->add_option("--threads", screen_args.threads, "runs at a time (0: one per core; one per rank under MPI)")
       ->capture_default_str();
@@ -144,6 +149,14 @@ int main(int argc, char** argv) {
   kc->add_option("--format", kc_args.format, "csv: the CSV/JSON files; mat: also a MAT v5 file")
       ->check(CLI::IsMember({"csv", "mat"}))->capture_default_str();
 
+  dydp::apps::FmuArgs fmu_args;
+  CLI::App* fmu = app.add_subcommand("fmu", "Export the scene (or an FMU description naming a scene, its inputs, outputs "
+                                            "and parameters) as an FMI 3.0 FMU with exact directional and adjoint derivatives");
+  fmu->add_option("scene", fmu_args.scene, "scene file or FMU description (YAML)")->required();
+  fmu->add_option("--out", fmu_args.out, "the FMU archive, NAME.fmu")->required();
+  fmu->add_option("--kind", fmu_args.kind, "me: Model Exchange, cs: Co-Simulation, both")
+      ->check(CLI::IsMember({"me", "cs", "both"}))->capture_default_str();
+
   CLI::App* blocks = app.add_subcommand("blocks", "List the block types with ports and parameters; [direction]: a parameter that can be a "
       "sensitivity direction, written BLOCK.PARAMETER in a scene's sensitivities: list");
 
@@ -166,6 +179,7 @@ int main(int argc, char** argv) {
     if (*modes) return dydp::apps::modes_command(linear_args);
     if (*frf) return dydp::apps::frf_command(linear_args);
     if (*kc) return dydp::apps::kc_command(kc_args);
+    if (*fmu) return dydp::apps::fmu_command(fmu_args);
     if (*blocks) return dydp::apps::blocks_command(std::cout);
   } catch (const dydp::engine::InputError& e) {
     err << e.what() << "\n";

@@ -134,6 +134,7 @@ int screen_command(const ScreenArgs& args) {
   spec.resume = args.resume;
   spec.threads = args.threads;
   spec.estimate = !args.no_estimate;
+  spec.adjoint = args.adjoint;
   const bool speaker = engine::world_rank() == 0;
   ProgressBar bar("screen");
   spec.progress = [&](int done, int todo) { bar.update(done, todo); };

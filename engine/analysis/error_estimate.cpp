@@ -55,9 +55,11 @@ ShadowPlan shadow_plan(const SolverSpec& solver, const TimeSpec& time) {
 void estimate_from_shadow(RunResult& run, const RunResult& shadow, const ShadowPlan& plan) {
   ErrorEstimate& e = run.stats.error_estimate;
   const int nsig = run.num_signals();
-  const int ns = static_cast<int>(run.sensitivity_names.size());
+  // an adjoint run's signals carry no sensitivities (its directions are the objectives' gradients')
+  const int ns = run.signal_sensitivities ? static_cast<int>(run.sensitivity_names.size()) : 0;
+  const int shadow_ns = shadow.signal_sensitivities ? static_cast<int>(shadow.sensitivity_names.size()) : 0;
   const size_t nt = std::min(run.t.size(), shadow.t.size());
-  if (shadow.num_signals() != nsig || static_cast<int>(shadow.sensitivity_names.size()) != ns || nt == 0) return;
+  if (shadow.num_signals() != nsig || shadow_ns != ns || nt == 0) return;
   // column c: -1 the signal i itself, else direction c of signal i
   auto column = [&](const RunResult& r, size_t k, int d, int i) { return d < 0 ? r.value(k, i) : r.tangent(k, d, i); };
   e = ErrorEstimate{};
@@ -97,7 +99,7 @@ RunResult run_with_error_estimate(const Diagram& d, Diagram& shadow, const RunOp
   // The same start as the run (`initial: equilibrium`: the same scene, the same parameters).
   if (shadow.start.x.empty()) shadow.start = d.start;
   RunOptions quiet;
-  quiet.sensitivities = options.sensitivities;
+  quiet.sensitivities = options.sensitivities && !options.adjoint;  // adjoint: the signals alone
   quiet.difference_quotient_sensitivities = options.difference_quotient_sensitivities;
   RunResult shadow_result;
   std::string shadow_failure;

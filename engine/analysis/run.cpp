@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "engine/analysis/cvodes_adjoint.hpp"
 #include "engine/analysis/cvodes_solver.hpp"
 #include "engine/analysis/rk4_solver.hpp"
 #include "engine/analysis/rosenbrock_solver.hpp"
@@ -17,7 +18,8 @@ RunResult run(const Diagram& d, const RunOptions& options) {
   if (d.initial.equilibrium && d.num_states > 0 && d.start.x.empty())
     throw std::logic_error("the scene starts at its equilibrium (initial: equilibrium) but none was computed: "
                            "run it through engine/studies/initial_equilibrium.hpp");
-  RunResult r = d.solver.method == "rk4"      ? run_rk4(d, options)
+  RunResult r = options.adjoint               ? run_cvodes_adjoint(d, options)
+                : d.solver.method == "rk4"      ? run_rk4(d, options)
                 : d.solver.method == "sdirk2" ? run_sdirk(d, options)
                 : d.solver.method == "rosw"   ? run_rosenbrock(d, options)
                                               : run_cvodes(d, options);

@@ -22,6 +22,12 @@ struct RunOptions {
   /// Called at every output time with the result so far (its last sample is the new one):
   /// for streaming outputs. An exception thrown here ends the run.
   std::function<void(const RunResult&)> on_sample;
+  /// The objectives' gradients by the adjoint method (engine/analysis/cvodes_adjoint.hpp): a
+  /// forward run with checkpoints, then one backward run for every objective together; the
+  /// signals carry no sensitivities. CVODES methods only.
+  bool adjoint = false;
+  /// Adjoint: forward steps between checkpoints (the chunks replayed one at a time backwards).
+  int steps_between_checkpoints = 1000;
 };
 
 /// A state that limited the step size (see engine/analysis/step_limiters.hpp).
@@ -42,6 +48,28 @@ struct ErrorEstimate {
   double cpu_seconds = 0.0;  ///< the shadow run's CPU time (its own thread), not in cpu_seconds
   std::string worst_signal;       ///< the column of the largest signal error
   std::string worst_sensitivity;  ///< the column of the largest sensitivity error
+};
+
+/// What the adjoint run did (run.json `adjoint`).
+struct AdjointStats {
+  bool used = false;
+  int objectives = 0;                ///< adjoint directions: the requested objectives
+  int segments = 0;                  ///< integration segments (between breakpoints)
+  long checkpoints = 0;              ///< forward checkpoints (chunks), all segments
+  int steps_between_checkpoints = 0; ///< the chunks' length, in forward steps
+  long replay_steps = 0;             ///< forward steps taken again, chunk by chunk, for the backward run
+  long replays_differing = 0;        ///< replayed chunks whose steps differ from the first pass's (0)
+  long backward_steps = 0;
+  long backward_rhs_evals = 0;       ///< adjoint passes for the adjoint states
+  long backward_quadrature_evals = 0;  ///< adjoint passes for the parameter gradient
+  long backward_jac_evals = 0;       ///< backward Newton matrices (the transposed diagram Jacobian)
+  long forward_steps = 0;            ///< of the forward run alone
+  /// Checkpoint and interpolation data held: a state per checkpoint, and y and y' per stored
+  /// step of the chunk being replayed (Hermite).
+  double checkpoint_bytes = 0.0;
+  double peak_rss_bytes = 0.0;       ///< the process's peak resident set when the run ended
+  double forward_cpu_seconds = 0.0;
+  double backward_cpu_seconds = 0.0;
 };
 
 struct RunStats {
@@ -71,6 +99,7 @@ struct RunStats {
   /// Variable-step solvers: the states that limited the step most often, most often first.
   std::vector<LimitingState> limiting_states;
   ErrorEstimate error_estimate;
+  AdjointStats adjoint;
 };
 
 struct ObjectiveResult {
@@ -89,6 +118,9 @@ struct RunResult {
   std::vector<double> t;                       ///< output grid
   std::vector<double> values;                  ///< values[k * nsig + i]
   std::vector<double> tangents;                ///< tangents[(k * ns + d) * nsig + i]
+  /// Whether the signals carry their sensitivities (tangents): false for an adjoint run, whose
+  /// sensitivity_names are those of the objectives' gradients only.
+  bool signal_sensitivities = true;
   std::vector<double> final_state;
   std::vector<ObjectiveResult> objectives;
   RunStats stats;

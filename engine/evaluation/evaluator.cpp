@@ -50,6 +50,11 @@ Evaluator::Evaluator(const Diagram& d, bool with_sensitivities)
   }
   dy_.resize(max_ports);
   y_.resize(max_ports);
+  ubar_.resize(max_ports);
+  wy_.resize(max_ports);
+  kept_outputs_.resize(d.output_steps.size());
+  kept_derivatives_.resize(nn);
+  kept_quadratures_.resize(nn);
 }
 
 Eval Evaluator::eval_for(const Node& n, int index, double t, const double* x) const {
@@ -108,6 +113,20 @@ void Evaluator::initial_state(double t0, double* x0) {
   }
 }
 
+namespace {
+
+/// The column of a start given from outside (Diagram::start) for sensitivity direction dir.
+const double* start_derivative(const Diagram& d, int dir) {
+  const auto& cols = d.start.parameters;
+  const auto c = std::find(cols.begin(), cols.end(), d.sensitivities[dir]);
+  if (c == cols.end())
+    throw std::logic_error("the run's start state has no derivative for direction " +
+                           d.parameters[d.sensitivities[dir]].name);
+  return d.start.dx_dp.data() + static_cast<size_t>(c - cols.begin()) * d.num_states;
+}
+
+}  // namespace
+
 void Evaluator::initial_state_tangent(double t0, const double* x0, DirView dx0) {
   for (int dir = 0; dir < ns_; ++dir)
     std::fill(dx0.data + dir * dx0.ld, dx0.data + dir * dx0.ld + d_.num_states, 0.0);
@@ -115,12 +134,7 @@ void Evaluator::initial_state_tangent(double t0, const double* x0, DirView dx0) 
   if (!d_.start.x.empty()) {  // its dx0/dp, the column of each direction
     const int nx = d_.num_states;
     for (int dir = 0; dir < ns_; ++dir) {
-      const auto& cols = d_.start.parameters;
-      const auto c = std::find(cols.begin(), cols.end(), d_.sensitivities[dir]);
-      if (c == cols.end())
-        throw std::logic_error("the run's start state has no derivative for direction " +
-                               d_.parameters[d_.sensitivities[dir]].name);
-      const double* from = d_.start.dx_dp.data() + static_cast<size_t>(c - cols.begin()) * nx;
+      const double* from = start_derivative(d_, dir);
       std::copy(from, from + nx, dx0.data + dir * dx0.ld);
     }
     return;
@@ -159,6 +173,7 @@ void Evaluator::outputs(double t, const double* x) {
         if (offset >= n.output_offset[k] && offset < n.output_offset[k] + n.block->outputs()[k].width) sig_[offset] = value;
   }
   valid_ = true;
+  ++value_pass_;
   last_t_ = t;
   if (nx) std::memcpy(last_x_.data(), x, nx * sizeof(double));
 }
@@ -221,6 +236,133 @@ void Evaluator::tangents(double t, const double* x, int nd, ConstDirView dx, boo
       if (states) n.block->derivatives_tangent(e, s, {dxdot.data + n.state_offset, dxdot.ld});
       if (quads) n.block->quadratures_tangent(e, s, {dqdot.data + n.quad_offset, dqdot.ld});
     });
+  }
+}
+
+Adjoint Evaluator::adjoint_for(const Node& n, int index, int nm, DirView ax, DirView ap) {
+  const int ld = d_.num_signals;
+  for (size_t k = 0; k < n.input_source.size(); ++k) ubar_[k] = {sbar_.data() + n.input_source[k], ld};
+  Adjoint a;
+  a.directions = nm;
+  if (ax.data && n.block->num_states() > 0) a.x = {ax.data + n.state_offset, ax.ld};
+  a.u = ubar_.data();
+  if (ap.data && driven_[index]) {
+    a.p_columns = ns_;
+    a.p_seeds = {pseed_.data() + pseed_offset_[index], static_cast<int>(n.p.size())};
+    a.p = ap;
+  }
+  return a;
+}
+
+const LocalJacobian& Evaluator::kept_jacobian(KeptJacobian& kept, const Node& n, int index, BlockFunction fn,
+                                              const Eval& e) {
+  if (kept.pass != value_pass_) {
+    const std::vector<bool> all_inputs(n.block->inputs().size(), true);
+    const ConstDirView p_seeds{pseed_.data() + pseed_offset_[index], static_cast<int>(n.p.size())};
+    kept.J = local_jacobian(*n.block, fn, e, true, all_inputs, driven_[index] ? ns_ : 0, p_seeds);
+    kept.pass = value_pass_;
+  }
+  return kept.J;
+}
+
+namespace {
+
+/// Whether rows [first, first + rows) of a weight view are zero in all nm directions.
+bool zero_weights(ConstDirView w, int first, int rows, int nm) {
+  if (w.zero()) return true;
+  for (int m = 0; m < nm; ++m)
+    for (int r = 0; r < rows; ++r)
+      if (w.data[m * w.ld + first + r] != 0.0) return false;
+  return true;
+}
+
+}  // namespace
+
+void Evaluator::adjoint(double t, const double* x, int nm, ConstDirView lambda, ConstDirView wq, DirView ax,
+                        DirView ap) {
+  outputs(t, x);
+  const int ld = d_.num_signals;
+  sbar_.assign(static_cast<size_t>(ld) * nm, 0.0);
+  // The states' and integrals' readers first: they read signals the output steps computed.
+  for (size_t i = 0; i < d_.nodes.size(); ++i) {
+    const Node& n = d_.nodes[i];
+    const int nx = n.block->num_states(), nq = n.block->num_quadratures();
+    const bool states = nx > 0 && !zero_weights(lambda, n.state_offset, nx, nm);
+    const bool quads = nq > 0 && !zero_weights(wq, n.quad_offset, nq, nm);
+    if (!states && !quads) continue;
+    const int idx = static_cast<int>(i);
+    const Eval e = eval_for(n, idx, t, x);
+    const Adjoint a = adjoint_for(n, idx, nm, ax, ap);
+    const ConstDirView wx{states ? lambda.data + n.state_offset : nullptr, lambda.ld};
+    const ConstDirView wqn{quads ? wq.data + n.quad_offset : nullptr, wq.ld};
+    call_block(n, [&] {
+      if (!n.block->adjoint_from_tangent()) {
+        if (states) n.block->derivatives_adjoint(e, wx, a);
+        if (quads) n.block->quadratures_adjoint(e, wqn, a);
+        return;
+      }
+      if (states)
+        add_transpose_product(*n.block, kept_jacobian(kept_derivatives_[i], n, idx, BlockFunction::derivatives, e),
+                              [&](int r, int m) { return wx(r, m); }, a);
+      if (quads)
+        add_transpose_product(*n.block, kept_jacobian(kept_quadratures_[i], n, idx, BlockFunction::quadratures, e),
+                              [&](int r, int m) { return wqn(r, m); }, a);
+    });
+  }
+  // Then the output steps backwards: every reader of a step's outputs comes after it in the
+  // forward order, so their adjoints are complete when the step is reached.
+  for (auto step = d_.output_steps.rbegin(); step != d_.output_steps.rend(); ++step) {
+    const int i = step->node;
+    const Node& n = d_.nodes[i];
+    const auto& ports = n.block->outputs();
+    bool any = false;
+    for (size_t k = 0; k < ports.size(); ++k) wy_[k] = {};
+    for (int k : step->outputs) {
+      const int offset = n.output_offset[k];
+      if (num_seeded_ > 0)  // a cut wire: its adjoint stops here
+        for (int w = 0; w < ports[k].width; ++w)
+          if (seeded_[offset + w] >= 0)
+            for (int m = 0; m < nm; ++m) sbar_[static_cast<size_t>(m) * ld + offset + w] = 0.0;
+      if (zero_weights({sbar_.data(), ld}, offset, ports[k].width, nm)) continue;
+      wy_[k] = {sbar_.data() + offset, ld};
+      any = true;
+    }
+    if (!any) continue;
+    Eval e = eval_for(n, i, t, x);
+    e.ready = step->ready.data();
+    e.inputs_ready = step->inputs_ready;
+    const Adjoint a = adjoint_for(n, i, nm, ax, ap);
+    const size_t at = static_cast<size_t>(d_.output_steps.rend() - step - 1);
+    call_block(n, [&] {
+      if (!n.block->adjoint_from_tangent()) return n.block->outputs_adjoint(e, wy_.data(), a);
+      add_transpose_product(*n.block, kept_jacobian(kept_outputs_[at], n, i, BlockFunction::outputs, e),
+                            output_weights(*n.block, wy_.data()), a);
+    });
+  }
+}
+
+void Evaluator::initial_state_adjoint(double t0, const double* x0, int nm, ConstDirView w, DirView ap) {
+  if (ns_ == 0 || w.zero() || !ap.data) return;
+  if (!d_.start.x.empty()) {  // a start given from outside: w^T of its dx0/dp columns
+    const int nx = d_.num_states;
+    for (int dir = 0; dir < ns_; ++dir) {
+      const double* column = start_derivative(d_, dir);
+      for (int m = 0; m < nm; ++m) {
+        double sum = 0.0;
+        for (int i = 0; i < nx; ++i) sum += w.data[m * w.ld + i] * column[i];
+        ap.data[m * ap.ld + dir] += sum;
+      }
+    }
+    return;
+  }
+  sbar_.assign(static_cast<size_t>(d_.num_signals) * nm, 0.0);
+  for (size_t i = 0; i < d_.nodes.size(); ++i) {
+    const Node& n = d_.nodes[i];
+    const int nx = n.block->num_states();
+    if (nx == 0 || !driven_[i] || zero_weights(w, n.state_offset, nx, nm)) continue;
+    const int idx = static_cast<int>(i);
+    const Adjoint a = adjoint_for(n, idx, nm, {}, ap);
+    n.block->initial_state_adjoint(eval_for(n, idx, t0, x0), {w.data + n.state_offset, w.ld}, a);
   }
 }
 

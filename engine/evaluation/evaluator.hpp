@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "engine/framework/diagram.hpp"
+#include "engine/framework/local_adjoint.hpp"
 
 namespace dydp::engine {
 
@@ -39,6 +40,22 @@ class Evaluator {
   /// signal tangents and, where given, dxdot (ld = num_states) and dqdot (ld = num_quadratures).
   void tangents(double t, const double* x, int nd, ConstDirView dx, bool with_params,
                 DirView dxdot, DirView dqdot);
+
+  /// Adjoint pass for nm adjoint directions, the transpose of the tangent pass: given weights
+  /// lambda on the state derivatives (ld = num_states, null data: zero) and wq on the quadrature
+  /// integrands (ld = num_quadratures, null data: zero), adds lambda^T f_x + wq^T q_x to ax
+  /// (ld = num_states) and, when ap has data, lambda^T f_p + wq^T q_p along the sensitivity
+  /// directions to ap (element (d, m) at ap.data[m * ap.ld + d]; the directions' parameter seeds
+  /// as the tangent pass applies them). The graph is run backwards: derivatives and quadratures
+  /// first, then the output steps in reverse order, each step's outputs weighted by the adjoint
+  /// its readers gave them. A signal the tangent pass seeds (set_signal_seeds) is a cut wire:
+  /// no adjoint flows through it to its block.
+  void adjoint(double t, const double* x, int nm, ConstDirView lambda, ConstDirView wq, DirView ax, DirView ap);
+  /// The adjoint of the initial state: adds w^T dx0/dp along the sensitivity directions to ap
+  /// (w: ld = num_states; ap as in adjoint()).
+  void initial_state_adjoint(double t0, const double* x0, int nm, ConstDirView w, DirView ap);
+  /// Signal adjoints of the last adjoint pass: element (i, m) at [m * num_signals + i].
+  const std::vector<double>& signal_adjoints() const { return sbar_; }
 
   /// Signals whose tangents the tangent pass sets instead of computing them: signal offsets[j]
   /// gets seeds[d * offsets.size() + j] in direction d, whatever its block would give (the wire
@@ -78,14 +95,29 @@ class Evaluator {
   bool all_finite(const double* xdot) const;
 
  private:
+  /// The local Jacobians of blocks whose adjoints come from their tangents, kept for the value
+  /// point they were built at (value_pass_): per output step, per node's derivatives and
+  /// quadratures; columns: all states, all ready inputs, the sensitivity directions if driven.
+  struct KeptJacobian {
+    long pass = -1;
+    LocalJacobian J;
+  };
   Eval eval_for(const Node& n, int index, double t, const double* x) const;
   Seeds seeds_for(const Node& n, int index, int nd, ConstDirView dx, bool with_params);
   void seed_signals(const Node& n, const OutputStep& step, int nd);
+  Adjoint adjoint_for(const Node& n, int index, int nm, DirView ax, DirView ap);
+  const LocalJacobian& kept_jacobian(KeptJacobian& kept, const Node& n, int index, BlockFunction fn, const Eval& e);
 
   const Diagram& d_;
   int ns_ = 0;
   double segment_start_ = 0.0;
   std::vector<double> sig_, dsig_;
+  std::vector<double> sbar_;           ///< signal adjoints of the last adjoint pass
+  /// per output step, per node's derivatives and quadratures
+  std::vector<KeptJacobian> kept_outputs_, kept_derivatives_, kept_quadratures_;
+  long value_pass_ = 0;                ///< counts the value passes computed (not cached)
+  std::vector<DirView> ubar_;          ///< scratch for a node's input adjoint views
+  std::vector<ConstDirView> wy_;       ///< scratch for a node's output weight views
   std::vector<double> pseed_;          ///< per node np x ns, d-major, concatenated
   std::vector<int> pseed_offset_;
   std::vector<bool> driven_;           ///< node has a parameter driven by a direction

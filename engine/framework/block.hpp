@@ -80,6 +80,25 @@ struct Seeds {
   ConstDirView p;                       ///< seeds of the block's parameters (zero for Jacobians)
 };
 
+/// Reverse-mode (adjoint) products for `directions` adjoint directions: given weights w on a
+/// function's values (outputs, xdot, qdot or x0), a block adds w^T g_x, w^T g_u and w^T g_p S to
+/// these views, column m for adjoint direction m. Results accumulate (+=); a view with null data
+/// is not wanted (its product is neither computed nor written). Block's defaults
+/// (engine/framework/block_adjoint.cpp) take the function's small local Jacobian from the block's
+/// own tangent, one unit seed per wanted state, input element and parameter column, and multiply
+/// its transpose: every block has a correct adjoint; a block may write a cheaper one.
+struct Adjoint {
+  int directions = 0;
+  DirView x;                   ///< += w^T g_x [num_states x directions]
+  const DirView* u = nullptr;  ///< u[k] += w^T g_{u_k} [width of port k x directions]; null: none
+  /// The parameter part is wanted along p_columns combinations of the block's parameters, the
+  /// columns of p_seeds (element (j, c): parameter j in column c; ld = the block's parameter
+  /// count), as the tangent's parameter seeds Seeds::p: p(c, m) += sum_j (w^T g_{p_j}) S(j, c).
+  int p_columns = 0;
+  ConstDirView p_seeds;
+  DirView p;                   ///< [p_columns x directions]
+};
+
 /// Thrown by a block whose input left its domain (negative volume, lift-off misuse, ...).
 /// The solver treats it as a recoverable failure and retries with a smaller step.
 struct OutOfDomain {
@@ -105,6 +124,8 @@ class Block {
   /// Initial state x(t0) and its tangent dx(t0) for the parameter seeds in s.p.
   virtual void initial_state(const Eval& e, double* x0) const {}
   virtual void initial_state_tangent(const Eval& e, const Seeds& s, DirView dx0) const {}
+  /// w^T dx0/dp S into a.p (the initial state reads parameters only: a.x and a.u are untouched).
+  virtual void initial_state_adjoint(const Eval& e, ConstDirView w, const Adjoint& a) const;
 
   /// Inputs that output k reads directly, sorted: those given to set_output_reads, else every
   /// feedthrough input for a feedthrough output, none for a state-only one.
@@ -141,11 +162,17 @@ class Block {
   /// dy = g_x dx + g_u du + g_p dp, for every output port and direction; called like outputs
   /// (the same ready inputs), reading the seeds of ready inputs only.
   virtual void outputs_tangent(const Eval& e, const Seeds& s, const DirView* dy) const = 0;
+  /// The transpose of outputs_tangent: w[k] weights output port k (null data: zero), and
+  /// w^T g_x, w^T g_u, w^T g_p S go into a. Called like outputs (the same ready inputs): only
+  /// the outputs that are output_ready may carry weights, and only ready inputs get products.
+  virtual void outputs_adjoint(const Eval& e, const ConstDirView* w, const Adjoint& a) const;
 
   /// xdot = f(t, x, u, p).
   virtual void derivatives(const Eval& e, double* xdot) const {}
   /// dxdot = f_x dx + f_u du + f_p dp.
   virtual void derivatives_tangent(const Eval& e, const Seeds& s, DirView dxdot) const {}
+  /// w^T f_x, w^T f_u, w^T f_p S for weights w on xdot.
+  virtual void derivatives_adjoint(const Eval& e, ConstDirView w, const Adjoint& a) const;
   /// Optional: d(xdot)/dx over the block's own states with its inputs held, column j at
   /// jac.data + j * jac.ld. Blocks whose derivatives are cheap but strongly nonlinear in their
   /// own states (hydraulic chambers) provide it, so that an implicit solver can refresh this
@@ -158,6 +185,13 @@ class Block {
   /// Integrands of the block's quadratures (objective integrals), and their tangents.
   virtual void quadratures(const Eval& e, double* qdot) const {}
   virtual void quadratures_tangent(const Eval& e, const Seeds& s, DirView dqdot) const {}
+  /// w^T of the integrands' derivatives, for weights w on qdot.
+  virtual void quadratures_adjoint(const Eval& e, ConstDirView w, const Adjoint& a) const;
+
+  /// True when the block's adjoints are Block's defaults (the transposed local Jacobians of its
+  /// tangent): the evaluator then builds those Jacobians once per value point and keeps them for
+  /// every adjoint pass at that point. A block that writes its own *_adjoint returns false.
+  virtual bool adjoint_from_tangent() const { return true; }
 
   /// Times in (t0, t1] where the block's laws are discontinuous; the solvers stop there.
   virtual std::vector<double> breakpoints(const double* p, double t0, double t1) const { return {}; }

@@ -30,6 +30,21 @@ class Objective {
   /// psi from the quadratures q at the end of the run; dpsi[d] from their seeds dq(., d).
   virtual double objective(const double* p, const double* q, ConstDirView dq,
                            const ObjectiveSamples& samples, double* dpsi) const = 0;
+  /// For the adjoint method: psi's gradient with respect to its nq quadratures at their end
+  /// values q, dpsi_dq[j] = dpsi/dq_j; false when psi is not a function of its quadratures
+  /// alone (it reads output samples) and so has no adjoint. The default applies objective() to
+  /// unit seeds, one per quadrature: exact, since objective()'s dpsi is linear in dq (and psi
+  /// depends on the parameters only through the quadratures).
+  virtual bool quadrature_gradient(const double* p, const double* q, int nq, const ObjectiveSamples& samples,
+                                   double* dpsi_dq) const {
+    if (needs_samples()) return false;
+    std::vector<double> unit(static_cast<size_t>(nq) * nq, 0.0);
+    for (int j = 0; j < nq; ++j) unit[static_cast<size_t>(j) * nq + j] = 1.0;
+    ObjectiveSamples s = samples;
+    s.directions = nq;
+    objective(p, q, {unit.data(), nq}, s, dpsi_dq);
+    return true;
+  }
 };
 
 }  // namespace dydp::engine

@@ -33,12 +33,14 @@ RunResult run_from_initial(Diagram& d, const RunOptions& options) {
   return run(d, options);
 }
 
-RunResult run_study_point(const std::function<Diagram()>& make, bool estimate) {
+RunResult run_study_point(const std::function<Diagram()>& make, bool estimate, bool adjoint) {
   Diagram d = make();
   start_at_equilibrium(d);
-  if (!estimate) return run(d);
+  RunOptions options;
+  options.adjoint = adjoint;
+  if (!estimate) return run(d, options);
   Diagram shadow = make();
-  return run_with_error_estimate(d, shadow, RunOptions{});
+  return run_with_error_estimate(d, shadow, options);
 }
 
 }  // namespace dydp::engine

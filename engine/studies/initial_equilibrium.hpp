@@ -27,6 +27,7 @@ RunResult run_from_initial(Diagram& d, const RunOptions& options = {});
 /// A study's run of the diagram `make` builds (a point of a sweep or a screening study): from
 /// its initial state or equilibrium, and with `estimate` its error estimated by a shadow run of
 /// a second diagram from `make` (engine/analysis/error_estimate.hpp) that starts where it does.
-RunResult run_study_point(const std::function<Diagram()>& make, bool estimate);
+/// With `adjoint`, the objectives' gradients by the adjoint method (RunOptions::adjoint).
+RunResult run_study_point(const std::function<Diagram()>& make, bool estimate, bool adjoint = false);
 
 }  // namespace dydp::engine

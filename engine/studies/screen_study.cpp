@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "engine/analysis/cvodes_adjoint.hpp"
 #include "engine/analysis/run.hpp"
 #include "engine/framework/errors.hpp"
 #include "engine/studies/initial_equilibrium.hpp"
@@ -56,6 +57,7 @@ ordered_json identity(const ScreenSpec& spec, const ScreenResult& r, const Diagr
   j["set"] = ordered_json::array();
   for (const auto& [name, value] : spec.overrides) j["set"].push_back(name + "=" + value);
   j["solver"] = {{"method", d.solver.method}, {"rtol", d.solver.rtol}, {"atol", d.solver.atol}, {"step", d.solver.step}};
+  if (spec.adjoint) j["adjoint"] = true;
   for (const auto& range : r.ranges)
     j["parameters"].push_back({{"name", range.name}, {"lower", range.lower}, {"upper", range.upper},
                                {"nominal", range.nominal}});
@@ -124,6 +126,7 @@ ScreenResult screen(const ScreenSpec& spec) {
   {
     Diagram check = load(spec);
     check.set_sensitivities(indices);
+    if (spec.adjoint) check_adjoint_possible(check);
   }
   for (int o : probe.objectives) {
     r.objectives.push_back(probe.nodes[o].name);
@@ -198,7 +201,7 @@ ScreenResult screen(const ScreenSpec& spec) {
       d.set_sensitivities(indices);
       return d;
     };
-    const RunResult result = run_study_point(at_point, spec.estimate);
+    const RunResult result = run_study_point(at_point, spec.estimate, spec.adjoint);
     ScreenRun sr;
     sr.index = k;
     sr.p = p;

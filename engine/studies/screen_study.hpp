@@ -25,6 +25,9 @@ struct ScreenSpec {
   bool resume = false;                  ///< keep the records of out/runs/, run only what is missing
   int threads = 0;                      ///< 0: one per core (one per rank under MPI)
   bool estimate = true;                 ///< each run estimates its own error (a shadow run beside it)
+  /// The gradients by the adjoint method (one backward run per point, whatever P); the runs'
+  /// error estimates then cover their signals only.
+  bool adjoint = false;
   /// Called on rank 0 after each recorded run: runs recorded so far in this invocation, runs
   /// this invocation has to do.
   std::function<void(int done, int todo)> progress;

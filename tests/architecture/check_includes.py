@@ -23,7 +23,8 @@ ALLOWED = {
     "blocks": ["engine/framework", "io", "generated_models", "symbolic"],
     "python": ["engine", "io", "blocks"],
     "gui": ["engine", "io", "blocks"],
-    "apps": ["engine", "io", "blocks", "symbolic", "generated_models"],
+    "fmi": ["engine", "io", "blocks"],
+    "apps": ["engine", "io", "blocks", "symbolic", "generated_models", "fmi"],
 }
 # tests/ and bench/ may include anything: they look at every layer from outside.
 UNCHECKED = ("tests", "bench", "build", ".git", "scripts", "docs", "scenarios")

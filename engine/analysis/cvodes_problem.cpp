@@ -1,0 +1,117 @@
+#include "engine/analysis/cvodes_problem.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include "engine/analysis/dense_lu_solver.hpp"
+#include "engine/analysis/sundials_kernels.hpp"
+#include "engine/framework/errors.hpp"
+
+namespace dydp::engine::cvodes {
+
+/// CVODES' name of a return flag. CVodeGetReturnFlagName mallocs the name; the caller frees it
+/// (found by scene_run_fuzz: every failed run leaked it).
+std::string flag_name(int flag) {
+  char* name = CVodeGetReturnFlagName(flag);
+  std::string s = name ? name : "unknown flag";
+  std::free(name);
+  return s;
+}
+
+int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
+  auto& P = *static_cast<Problem*>(user);
+  double* xdot = NV_DATA_S(ydot);
+  if (!P.scene_values.empty()) P.ev.use_parameter_values(P.scene_values.data());
+  if (P.nx + P.nq == 0) xdot[0] = 0.0;
+  if (const int flag = guarded(P, t, [&] {
+        P.ev.derivatives(t, NV_DATA_S(y), xdot);
+        if (P.nq > 0) P.ev.quadratures(t, NV_DATA_S(y), xdot + P.nx);  // the same value pass
+      }))
+    return flag;
+  if (!P.ev.all_finite(xdot)) {
+    P.refuse(t, P.ev.find_nonfinite(xdot));
+    return 1;  // recoverable: CVODES retries with a smaller step, then fails naming it
+  }
+  return 0;
+}
+
+int sens_rhs(int ns, sunrealtype t, N_Vector y, N_Vector, N_Vector* yS, N_Vector* ySdot,
+             void* user, N_Vector, N_Vector) {
+  auto& P = *static_cast<Problem*>(user);
+  return guarded(P, t, [&] {
+    gather(yS, P.nx, ns, P.dx);  // the states' part: nothing reads the integrals
+    P.dxdot.assign(static_cast<size_t>(P.ny) * ns, 0.0);
+    P.ev.tangents(t, NV_DATA_S(y), ns, {P.dx.data(), P.nx}, true, {P.dxdot.data(), P.ny},
+                  {P.dxdot.data() + P.nx, P.ny});
+    scatter(P.dxdot, P.ny, ns, ySdot);
+    ++P.sens_passes;
+  });
+}
+
+// The Newton matrix's columns for the states from one tangent pass seeded on each; the
+// integrals' rows come with it, and their columns are zero (nothing reads an integral).
+int jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix J, void* user, N_Vector, N_Vector,
+             N_Vector) {
+  auto& P = *static_cast<Problem*>(user);
+  SUNMatZero(J);
+  if (P.nx == 0) return 0;
+  return guarded(P, t, [&] {
+    const int ld = static_cast<int>(SM_ROWS_D(J));
+    P.colouring.evaluate(P.ev, t, NV_DATA_S(y), {SM_DATA_D(J), ld}, {SM_DATA_D(J) + P.nx, ld});
+    ++P.jac_passes;
+  });
+}
+
+void error_handler(int, const char* module, const char* function, char* msg, void* user) {
+  static_cast<Problem*>(user)->cvodes_message = std::string(function) + ": " + msg;
+}
+
+/// The blocks' own diagonal blocks of the Newton matrix (Block::local_jacobian: a damper's
+/// pressures) refreshed at every factorisation, at the state of the Newton iteration's first
+/// right-hand side (which the evaluator still holds, so they cost the blocks' own derivatives
+/// only). CVODES keeps the whole Jacobian for many steps, and a kept one fails where the stiff,
+/// strongly nonlinear hydraulic blocks have moved on (an orifice's flow goes as the root of its
+/// pressure drop). With this refresh and a set-up every few steps, the main job's Newton
+/// failures, each a whole Jacobian and a retry, fall from 494 to 87 on 4 s (docs/engine.md).
+/// False when no block provides a local Jacobian (nothing is set).
+bool refresh_local_blocks(Problem& P, void* mem, SUNLinearSolver solver, double t0, const double* x0) {
+  if (P.nx == 0) return false;
+  const int nx = P.nx;
+  // which blocks provide one: found once, at the initial state
+  {
+    std::vector<double> probe(static_cast<size_t>(nx) * nx, std::numeric_limits<double>::quiet_NaN());
+    try {
+      if (!P.ev.local_jacobians(t0, x0, probe.data(), nx)) return false;
+    } catch (const OutOfDomain&) {
+      return false;
+    }
+    for (const Node& n : P.d.nodes) {
+      const int o = n.state_offset, k = n.block->num_states();
+      if (k > 0 && !std::isnan(probe[static_cast<size_t>(o) * nx + o])) P.local_blocks.emplace_back(o, k);
+    }
+  }
+  P.local.assign(static_cast<size_t>(nx) * nx, 0.0);
+  set_matrix_refresh(solver, [&P, mem, nx](SUNMatrix A) {
+    double gamma = 0.0, t = 0.0;
+    N_Vector y = nullptr;
+    if (CVodeGetCurrentGamma(mem, &gamma) != CV_SUCCESS || CVodeGetCurrentTime(mem, &t) != CV_SUCCESS ||
+        CVodeGetCurrentState(mem, &y) != CV_SUCCESS)
+      return;
+    try {
+      if (!P.ev.local_jacobians(t, NV_DATA_S(y), P.local.data(), nx)) return;
+    } catch (const OutOfDomain&) {
+      return;  // the kept matrix as it is: the step's own evaluation reports the point
+    }
+    const sunindextype ld = SM_ROWS_D(A);
+    double* a = SM_DATA_D(A);
+    for (const auto& [o, k] : P.local_blocks)
+      for (int j = 0; j < k; ++j)
+        for (int i = 0; i < k; ++i)
+          a[(o + j) * ld + o + i] = (i == j ? 1.0 : 0.0) - gamma * P.local[static_cast<size_t>(o + j) * nx + o + i];
+    ++P.local_refreshes;
+  });
+  return true;
+}
+
+}  // namespace dydp::engine::cvodes

@@ -1,0 +1,142 @@
+#include "fmi/cvodes_stepper.hpp"
+
+#include <cvodes/cvodes.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "engine/framework/block.hpp"
+#include "engine/framework/errors.hpp"
+
+namespace dydp::fmi {
+namespace {
+
+N_Vector vec(void* p) { return static_cast<N_Vector>(p); }
+
+int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
+  auto* s = static_cast<CvodesStepper*>(user);
+  try {
+    s->model.move_to(t, N_VGetArrayPointer(y));
+    s->model.derivatives(N_VGetArrayPointer(ydot));
+    for (int i = 0; i < s->model.num_states(); ++i)
+      if (!std::isfinite(N_VGetArrayPointer(ydot)[i])) return 1;  // recoverable: a smaller step
+    return 0;
+  } catch (const engine::OutOfDomain& e) {
+    s->failure = e.reason, s->failure_time = t;
+    return 1;
+  } catch (const std::exception& e) {
+    s->failure = e.what(), s->failure_time = t;
+    return -1;
+  }
+}
+
+int jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix jac, void* user, N_Vector, N_Vector, N_Vector) {
+  auto* s = static_cast<CvodesStepper*>(user);
+  try {
+    s->model.move_to(t, N_VGetArrayPointer(y));
+    s->model.state_jacobian(SUNDenseMatrix_Data(jac));
+    return 0;
+  } catch (const engine::OutOfDomain& e) {
+    s->failure = e.reason, s->failure_time = t;
+    return 1;
+  } catch (const std::exception& e) {
+    s->failure = e.what(), s->failure_time = t;
+    return -1;
+  }
+}
+
+void silent(int, const char*, const char*, char*, void*) {}
+
+void check(int flag, const char* call) {
+  if (flag < 0) throw std::runtime_error(std::string("CVODES ") + call + " failed (flag " + std::to_string(flag) + ")");
+}
+
+}  // namespace
+
+CvodesStepper::CvodesStepper(FmuModel& m, const StepperSettings& settings) : model(m), settings_(settings) {
+  SUNContext ctx = nullptr;
+  check(SUNContext_Create(nullptr, &ctx), "SUNContext_Create");
+  context_ = ctx;
+  const int n = std::max(model.num_states(), 1);
+  y_ = N_VNew_Serial(n, ctx);
+  atol_ = N_VNew_Serial(n, ctx);
+  for (int i = 0; i < n; ++i)
+    N_VGetArrayPointer(vec(atol_))[i] = settings_.atol * (i < model.num_states() ? model.table().nominals[i] : 1.0);
+  cvode_ = CVodeCreate(CV_BDF, ctx);
+  if (!cvode_) throw std::runtime_error("CVODES CVodeCreate failed");
+  std::fill_n(N_VGetArrayPointer(vec(y_)), n, 0.0);
+  check(CVodeInit(cvode_, rhs, model.time(), vec(y_)), "CVodeInit");
+  check(CVodeSetErrHandlerFn(cvode_, silent, nullptr), "CVodeSetErrHandlerFn");
+  check(CVodeSVtolerances(cvode_, settings_.rtol, vec(atol_)), "CVodeSVtolerances");
+  check(CVodeSetUserData(cvode_, this), "CVodeSetUserData");
+  matrix_ = SUNDenseMatrix(n, n, ctx);
+  solver_ = SUNLinSol_Dense(vec(y_), static_cast<SUNMatrix>(matrix_), ctx);
+  check(CVodeSetLinearSolver(cvode_, static_cast<SUNLinearSolver>(solver_), static_cast<SUNMatrix>(matrix_)),
+        "CVodeSetLinearSolver");
+  check(CVodeSetJacFn(cvode_, jacobian), "CVodeSetJacFn");
+  check(CVodeSetMaxNumSteps(cvode_, settings_.max_steps), "CVodeSetMaxNumSteps");
+  if (settings_.max_order > 0) check(CVodeSetMaxOrd(cvode_, settings_.max_order), "CVodeSetMaxOrd");
+}
+
+CvodesStepper::~CvodesStepper() {
+  CVodeFree(&cvode_);
+  SUNLinSolFree(static_cast<SUNLinearSolver>(solver_));
+  SUNMatDestroy(static_cast<SUNMatrix>(matrix_));
+  N_VDestroy(vec(y_));
+  N_VDestroy(vec(atol_));
+  SUNContext ctx = static_cast<SUNContext>(context_);
+  SUNContext_Free(&ctx);
+}
+
+void CvodesStepper::restart() {
+  std::copy(model.states().begin(), model.states().end(), N_VGetArrayPointer(vec(y_)));
+  check(CVodeReInit(cvode_, model.time(), vec(y_)), "CVodeReInit");
+}
+
+long CvodesStepper::steps() const {
+  long n = 0;
+  CVodeGetNumSteps(cvode_, &n);
+  return steps_before_ + n;
+}
+
+void CvodesStepper::advance(double t_end) {
+  if (model.num_states() == 0) {  // nothing to integrate: time moves on
+    model.move_to(t_end, nullptr);
+    return;
+  }
+  while (model.time() < t_end) {
+    const double t_break = model.next_breakpoint(model.time());
+    const double target = std::min(t_end, t_break);
+    if (model.changes() != seen_changes_) {
+      steps_before_ = steps();
+      restart();
+    }
+    check(CVodeSetStopTime(cvode_, target), "CVodeSetStopTime");
+    sunrealtype reached = model.time();
+    failure.clear();
+    const int flag = CVode(cvode_, target, vec(y_), &reached, CV_NORMAL);
+    if (flag < 0) {
+      const std::string why = failure.empty() ? "CVODES failed (flag " + std::to_string(flag) + ")" : failure;
+      const double at = failure.empty() ? reached : failure_time;
+      model.move_to(reached, N_VGetArrayPointer(vec(y_)));
+      seen_changes_ = -1;
+      if (!failure.empty() && failure.find(": ") != std::string::npos)
+        throw engine::domain_failure(at, engine::OutOfDomain{why});
+      throw engine::SolverError(at, "", why);
+    }
+    model.move_to(target, N_VGetArrayPointer(vec(y_)));
+    if (target == t_break) {  // a breakpoint: the right-hand side may jump, BDF starts again
+      model.set_segment_start(target);
+      seen_changes_ = -1;
+    } else {
+      seen_changes_ = model.changes();
+    }
+  }
+}
+
+}  // namespace dydp::fmi
