@@ -682,33 +682,85 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
   return EmittedFunction{options.function_name, wrapped_signature(signature) + ";\n", body, true};
 }
 
-EmittedFunction emit_grouped_tangent(const GroupedTangent& grouped, std::span<const ArrayId> seeded_arrays,
-                                     const EmitOptions& options) {
+GroupedTangentFunctions emit_grouped_tangent(const GroupedTangent& grouped, std::span<const ArrayId> seeded_arrays,
+                                             const EmitOptions& options) {
   const EquationList& tangent = grouped.list;
   check_size(tangent, options);
   const Context& ctx = tangent.context();
-  const std::string signature = linkage(options) + "void " + options.function_name + "(" +
-                                input_parameters(ctx) + "const int* nd, " + seed_parameters(ctx, seeded_arrays) +
-                                "double* out, double* dout) noexcept";
-  std::string body = summary(tangent, options.function_name) +
-                     "// primal once, then each block's derivative part once per direction of that block:\n"
-                     "// nd[b] directions for block b, the blocks' directions one after the other;\n"
-                     "// seed (i, d) at seed_x[d*n + i], derivative (j, d) at dout[d*k + j]\n" +
-                     cloned_definition(signature, options) + "\n{\n";
-  write_primal(tangent, options, body);
-  body += "  int d0 = 0;\n";
+  std::vector<char> primal(ctx.size(), 0);
+  for (std::size_t i = 0; i < tangent.primal_assignments(); ++i) primal[tangent.assignments()[i].target] = 1;
+  // per block, the primal auxiliaries and sines and cosines it reads anywhere (operands,
+  // conditions, arguments), in node order; their union is the workspace, each at its slot
+  std::vector<std::vector<NodeId>> reads(grouped.blocks.size());
+  std::vector<long> slot(ctx.size(), -1);
   for (std::size_t b = 0; b < grouped.blocks.size(); ++b) {
     const TangentBlock& block = grouped.blocks[b];
-    std::string seeds;
-    for (const auto& [array, seed] : block.seeds) seeds += " " + ctx.array(array).name;
-    body += "  {  // block " + std::to_string(b) + ": " + one_line(block.label) + ", seeded on" + seeds + "\n";
-    body += "    const int nb = nd[" + std::to_string(b) + "];\n";
-    write_block(tangent, block, "nb", "d0", "    ", body);
-    body += "    d0 += nb;\n";
-    body += "  }\n";
+    walk_range(tangent, block.assignments_begin, block.assignments_end, block.outputs_begin, block.outputs_end,
+               [&](NodeId x) {
+      const bool value = ctx.is_abbreviation(x) ||
+                         (ctx.op(x) == Op::Symbol && ctx.symbol(x).kind == SymbolKind::Aux && primal[x]);
+      if (value) reads[b].push_back(x);
+      return !value && ctx.op(x) != Op::Symbol;
+    });
+    std::sort(reads[b].begin(), reads[b].end());
+    for (NodeId x : reads[b]) slot[x] = 0;
   }
-  body += "}\n";
-  return EmittedFunction{options.function_name, wrapped_signature(signature) + ";\n", body, true};
+  std::vector<NodeId> workspace;
+  for (NodeId x = 0; x < ctx.size(); ++x)
+    if (slot[x] == 0) {
+      slot[x] = static_cast<long>(workspace.size());
+      workspace.push_back(x);
+    }
+  auto value_name = [&](NodeId x) { return ctx.is_abbreviation(x) ? ctx.abbreviation_name(x) : ctx.symbol(x).name; };
+
+  GroupedTangentFunctions result;
+  std::string inputs;  // the input arrays as arguments
+  for (ArrayId a = 0; a < ctx.array_count(); ++a)
+    if (ctx.array(a).kind != SymbolKind::Seed) inputs += ctx.array(a).name + ", ";
+  std::string seeds;  // the seed arrays as arguments
+  for (ArrayId a : seeded_arrays) seeds += "seed_" + ctx.array(a).name + ", ";
+  std::string seed_declarations;
+  for (ArrayId a : seeded_arrays) seed_declarations += "[[maybe_unused]] const double* seed_" + ctx.array(a).name + ", ";
+
+  const std::string entry_signature = linkage(options) + "void " + options.function_name + "(" +
+                                      input_parameters(ctx) + "const int* nd, " + seed_parameters(ctx, seeded_arrays) +
+                                      "double* out, double* dout) noexcept";
+  std::string entry = summary(tangent, options.function_name) +
+                      "// primal once, the primal values the blocks read stored in a workspace, then each block's\n"
+                      "// function once per direction of that block: nd[b] directions for block b, the blocks'\n"
+                      "// directions one after the other; seed (i, d) at seed_x[d*n + i], derivative (j, d) at\n"
+                      "// dout[d*k + j]\n" +
+                      cloned_definition(entry_signature, options) + "\n{\n";
+  write_primal(tangent, options, entry);
+  entry += "  double work[" + std::to_string(std::max<std::size_t>(workspace.size(), 1)) + "];\n";
+  for (std::size_t k = 0; k < workspace.size(); ++k)
+    entry += "  work[" + std::to_string(k) + "] = " + value_name(workspace[k]) + ";\n";
+  entry += "  int d0 = 0;\n";
+  for (std::size_t b = 0; b < grouped.blocks.size(); ++b) {
+    const TangentBlock& block = grouped.blocks[b];
+    const std::string name = options.function_name + "_block_" + std::to_string(b);
+    const std::string nb = "nd[" + std::to_string(b) + "]";
+    entry += "  if (" + nb + " > 0) " + name + "(" + inputs + "work, " + nb + ", d0, " + seeds + "dout);\n";
+    entry += "  d0 += " + nb + ";\n";
+
+    std::string seeded;
+    for (const auto& [array, seed] : block.seeds) seeded += " " + ctx.array(array).name;
+    const std::string signature = linkage(options) + "void " + name + "(" + input_parameters(ctx) +
+                                  "const double* work, int nb, int d0, " + seed_declarations + "double* dout) noexcept";
+    std::string body = "// block " + std::to_string(b) + " of " + options.function_name + " (" +
+                       std::to_string(block.assignments_end - block.assignments_begin) +
+                       " assignments), seeded on" + seeded + ":\n// " + one_line(block.label) +
+                       "; the primal values it reads come from work\n" + cloned_definition(signature, options) +
+                       "\n{\n";
+    for (NodeId x : reads[b])
+      body += "  const double " + value_name(x) + " = work[" + std::to_string(slot[x]) + "];\n";
+    write_block(tangent, block, "nb", "d0", "  ", body);
+    body += "}\n";
+    result.blocks.push_back(EmittedFunction{name, wrapped_signature(signature) + ";\n", body, true});
+  }
+  entry += "}\n";
+  result.entry = EmittedFunction{options.function_name, wrapped_signature(entry_signature) + ";\n", entry, false};
+  return result;
 }
 
 EmittedFunction emit_trig_table(std::size_t size, const EmitOptions& options) {

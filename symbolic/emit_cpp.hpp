@@ -52,11 +52,20 @@ EmittedFunction emit_tangent(const EquationList& tangent, std::span<const ArrayI
                              const EmitOptions& options);
 
 // A tangent in blocks (grouped_tangent): the primal once, then each block's derivative part over
-// its own directions. As emit_tangent's, with `const int* nd` (nd[b] directions for block b, the
-// blocks' directions consecutive in the seed arrays and in dout) instead of `int nd`;
+// its own directions, as functions that may be compiled in translation units of their own (the
+// sedan's blocks together are one function of 28 000 assignments otherwise). `entry` has
+// emit_tangent's arguments with `const int* nd` (nd[b] directions for block b, the blocks'
+// directions consecutive in the seed arrays and in dout) instead of `int nd`; it evaluates the
+// primal, writes `out`, stores the primal values the blocks read in a workspace on its stack and
+// calls blocks[b] for block b's directions:
+//   void NAME_block_B(inputs..., const double* work, int nb, int d0, seeds..., double* dout) noexcept;
 // `seeded_arrays`: every array some block seeds, in the order of the seed arguments.
-EmittedFunction emit_grouped_tangent(const GroupedTangent& grouped, std::span<const ArrayId> seeded_arrays,
-                                     const EmitOptions& options);
+struct GroupedTangentFunctions {
+  EmittedFunction entry;
+  std::vector<EmittedFunction> blocks;
+};
+GroupedTangentFunctions emit_grouped_tangent(const GroupedTangent& grouped, std::span<const ArrayId> seeded_arrays,
+                                             const EmitOptions& options);
 
 // The table function of EmitOptions::trig_table for an array of `size` elements: sin and cos of
 // every element, computed again only when the array differs from the previous call's on the same

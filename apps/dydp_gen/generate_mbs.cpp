@@ -243,7 +243,10 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   velocity_tangent.push_back(
       tangent(name + "_residual_velocity_tangent", *lists.residual, {lists.qd, lists.qdd, lists.inp, lists.p}));
   const std::size_t n = model.coordinates(), m = model.constraint_count();
-  std::vector<EmittedFunction> tangent_groups_tu;  // its own file: the largest of the model's functions
+  std::vector<EmittedFunction> tangent_groups_tu;  // its own file: the entry of the grouped tangent
+  // its blocks' functions, kTangentBlockFiles files balanced by assignments (the sedan's blocks
+  // together are 28 000 assignments: one file of them took 6.5 minutes to compile under ASan)
+  std::vector<std::vector<EmittedFunction>> tangent_block_files(kTangentBlockFiles);
   // (jacobian_nonzero: the descriptor's, and the coupling of the tangent's coordinate groups)
   const std::vector<int> jacobian_nonzero = jacobian_structure(lists, static_cast<int>(m), static_cast<int>(n));
   std::vector<int> tangent_group(n, -1);
@@ -324,9 +327,26 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
         const std::size_t size = grouped.blocks[b].assignments_end - grouped.blocks[b].assignments_begin;
         result.parts.push_back({fn + "." + grouped.blocks[b].label, size, size, block_ops(grouped, b)});
       }
-      EmittedFunction f = emit_grouped_tangent(grouped, all_seeded, emit);
-      measure_text(f.definition, result.functions.back());
-      tangent_groups_tu.push_back(std::move(f));
+      GroupedTangentFunctions f = emit_grouped_tangent(grouped, all_seeded, emit);
+      std::string text = f.entry.definition;
+      for (const auto& block : f.blocks) text += block.definition;
+      measure_text(text, result.functions.back());
+      tangent_groups_tu.push_back(std::move(f.entry));
+      // the largest block first into the file with the fewest assignments so far
+      std::vector<std::size_t> order(f.blocks.size()), load(kTangentBlockFiles, 0);
+      for (std::size_t b = 0; b < order.size(); ++b) order[b] = b;
+      auto size = [&](std::size_t b) { return grouped.blocks[b].assignments_end - grouped.blocks[b].assignments_begin; };
+      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return size(a) > size(b); });
+      std::vector<std::vector<std::size_t>> members(kTangentBlockFiles);
+      for (std::size_t b : order) {
+        const auto file = static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+        load[file] += size(b);
+        members[file].push_back(b);
+      }
+      for (std::size_t file = 0; file < members.size(); ++file) {
+        std::sort(members[file].begin(), members[file].end());
+        for (std::size_t b : members[file]) tangent_block_files[file].push_back(std::move(f.blocks[b]));
+      }
       tangent_groups = static_cast<int>(kept.size());
       for (std::size_t g = 0; g < kept.size(); ++g)
         for (int c : kept[g]) tangent_group[c] = static_cast<int>(g);
@@ -341,6 +361,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   std::vector<EmittedFunction> all = dynamics;
   for (const auto* part : {&residual_tangent, &velocity_tangent, &tangent_groups_tu, &kinematics, &sensors})
     all.insert(all.end(), part->begin(), part->end());
+  for (const auto& file : tangent_block_files) all.insert(all.end(), file.begin(), file.end());
   const std::string header = name + ".hpp";
   std::string header_text = emit_header_file(all, emit);
   header_text += "\n#include \"symbolic/mbs/generated_model.hpp\"\n\nnamespace dydp::generated {\nextern const dydp::mbs::GeneratedModel " +
@@ -350,6 +371,9 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   write_atomically(options.out_dir / (name + "_residual_tangent.cpp"), emit_source_file(residual_tangent, header, emit));
   write_atomically(options.out_dir / (name + "_velocity_tangent.cpp"), emit_source_file(velocity_tangent, header, emit));
   write_atomically(options.out_dir / (name + "_tangent_groups.cpp"), emit_source_file(tangent_groups_tu, header, emit));
+  for (std::size_t file = 0; file < tangent_block_files.size(); ++file)
+    write_atomically(options.out_dir / (name + "_tangent_blocks_" + std::to_string(file) + ".cpp"),
+                     emit_source_file(tangent_block_files[file], header, emit));
   write_atomically(options.out_dir / (name + "_kinematics.cpp"), emit_source_file(kinematics, header, emit));
   write_atomically(options.out_dir / (name + "_sensors.cpp"), emit_source_file(sensors, header, emit));
 
