@@ -18,36 +18,40 @@ namespace {
 
 N_Vector vec(void* p) { return static_cast<N_Vector>(p); }
 
-int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
-  auto* s = static_cast<CvodesStepper*>(user);
+// A callback's body for CVODES (as engine::cvodes::guarded for the engine's runs): its own
+// result, or 1 (recoverable: a smaller step) when a block refused the point, -1 on any other
+// failure; what failed is kept for advance's message.
+template <class F>
+int guarded(CvodesStepper& s, double t, F&& body) {
   try {
-    s->model.move_to(t, N_VGetArrayPointer(y));
-    s->model.derivatives(N_VGetArrayPointer(ydot));
-    for (int i = 0; i < s->model.num_states(); ++i)
-      if (!std::isfinite(N_VGetArrayPointer(ydot)[i])) return 1;  // recoverable: a smaller step
-    return 0;
+    return body();
   } catch (const engine::OutOfDomain& e) {
-    s->failure = e.reason, s->failure_time = t;
+    s.failure = e.reason, s.failure_time = t;
     return 1;
   } catch (const std::exception& e) {
-    s->failure = e.what(), s->failure_time = t;
+    s.failure = e.what(), s.failure_time = t;
     return -1;
   }
 }
 
-int jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix jac, void* user, N_Vector, N_Vector, N_Vector) {
-  auto* s = static_cast<CvodesStepper*>(user);
-  try {
-    s->model.move_to(t, N_VGetArrayPointer(y));
-    s->model.state_jacobian(SUNDenseMatrix_Data(jac));
+int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
+  auto& s = *static_cast<CvodesStepper*>(user);
+  return guarded(s, t, [&] {
+    s.model.move_to(t, N_VGetArrayPointer(y));
+    s.model.derivatives(N_VGetArrayPointer(ydot));
+    for (int i = 0; i < s.model.num_states(); ++i)
+      if (!std::isfinite(N_VGetArrayPointer(ydot)[i])) return 1;  // recoverable: a smaller step
     return 0;
-  } catch (const engine::OutOfDomain& e) {
-    s->failure = e.reason, s->failure_time = t;
-    return 1;
-  } catch (const std::exception& e) {
-    s->failure = e.what(), s->failure_time = t;
-    return -1;
-  }
+  });
+}
+
+int jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix jac, void* user, N_Vector, N_Vector, N_Vector) {
+  auto& s = *static_cast<CvodesStepper*>(user);
+  return guarded(s, t, [&] {
+    s.model.move_to(t, N_VGetArrayPointer(y));
+    s.model.state_jacobian(SUNDenseMatrix_Data(jac));
+    return 0;
+  });
 }
 
 void silent(int, const char*, const char*, char*, void*) {}

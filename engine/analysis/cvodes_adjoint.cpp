@@ -119,9 +119,7 @@ struct Chunk {
 /// One CVODES problem of the forward run (a chunk), and for its replay the backward problem.
 struct Solver {
   void* mem = nullptr;
-  SUNMatrix A = nullptr;
-  SUNLinearSolver LS = nullptr;
-  SUNNonlinearSolver NLS = nullptr;
+  ForwardSolvers forward;
   SUNMatrix AB = nullptr;
   SUNLinearSolver LSB = nullptr;
   SUNNonlinearSolver NLSB = nullptr;
@@ -130,9 +128,6 @@ struct Solver {
   Solver& operator=(const Solver&) = delete;
   ~Solver() {
     if (mem) CVodeFree(&mem);
-    if (LS) SUNLinSolFree(LS);
-    if (A) SUNMatDestroy(A);
-    if (NLS) SUNNonlinSolFree(NLS);
     if (LSB) SUNLinSolFree(LSB);
     if (AB) SUNMatDestroy(AB);
     if (NLSB) SUNNonlinSolFree(NLSB);
@@ -143,17 +138,6 @@ struct Context {
   SUNContext ctx = nullptr;
   ~Context() {
     if (ctx) SUNContext_Free(&ctx);
-  }
-};
-
-struct Vector {
-  N_Vector v = nullptr;
-  Vector() = default;
-  explicit Vector(N_Vector w) : v(w) {}
-  Vector(const Vector&) = delete;
-  Vector& operator=(Vector&& o) noexcept { std::swap(v, o.v); return *this; }
-  ~Vector() {
-    if (v) N_VDestroy(v);
   }
 };
 
@@ -189,15 +173,9 @@ RunResult run_cvodes_adjoint(const Diagram& d, const RunOptions& options) {
   Recorder recorder(d, 0, result, options);
   Problem P(d, ev, nx, 0);
   Context C;
-  auto check = [&](int flag, const char* call, double t) {
-    if (flag < 0)
-      throw SolverError(t, P.refusal.empty() ? "" : P.refusal.substr(0, P.refusal.find(':')),
-                        std::string(call) + " failed: " + flag_name(flag) +
-                            (P.cvodes_message.empty() ? "" : " (" + P.cvodes_message + ")") +
-                            (P.refusal.empty() ? "" : "; last refused point: " + P.refusal));
-  };
+  auto check = [&](int flag, const char* call, double t) { check_call(P, flag, call, t); };
   check(SUNContext_Create(nullptr, &C.ctx), "SUNContext_Create", t0);
-  Vector y(N_VNew_Serial(n_cv, C.ctx));
+  OwnedVector y(N_VNew_Serial(n_cv, C.ctx));
   N_VEnableFusedOps_Serial(y.v, SUNTRUE);
   use_compiled_vector_kernels(y.v);
   N_VConst(0.0, y.v);
@@ -206,10 +184,7 @@ RunResult run_cvodes_adjoint(const Diagram& d, const RunOptions& options) {
   const std::vector<double> x0(NV_DATA_S(y.v), NV_DATA_S(y.v) + nx);
 
   const AbsoluteTolerances atols = absolute_tolerances(d, d.solver.atol, 0);
-  Vector atol_states(N_VClone(y.v));
-  N_VConst(d.solver.atol, atol_states.v);
-  std::copy_n(atols.states.data(), nx, NV_DATA_S(atol_states.v));
-  std::copy_n(atols.quadratures.data(), nq, NV_DATA_S(atol_states.v) + nx);
+  OwnedVector atol_states(state_tolerances(P, atols, d.solver.atol, y.v));
 
   const Timeline timeline(d);
   std::vector<double> bounds = {t0};
@@ -234,30 +209,8 @@ RunResult run_cvodes_adjoint(const Diagram& d, const RunOptions& options) {
     ev.set_segment_start(c.segment_start);
     S.mem = CVodeCreate(bdf ? CV_BDF : CV_ADAMS, C.ctx);
     if (!S.mem) throw SolverError(c.start, "", "CVodeCreate failed");
-    void* mem = S.mem;
-    const double ts = c.start;
-    check(CVodeSetErrHandlerFn(mem, error_handler, &P), "CVodeSetErrHandlerFn", ts);
-    check(CVodeInit(mem, rhs, ts, y.v), "CVodeInit", ts);
-    check(CVodeSetUserData(mem, &P), "CVodeSetUserData", ts);
-    check(CVodeSVtolerances(mem, d.solver.rtol, atol_states.v), "CVodeSVtolerances", ts);
-    check(CVodeSetMaxNumSteps(mem, d.solver.max_steps), "CVodeSetMaxNumSteps", ts);
-    check(CVodeSetMinStep(mem, d.solver.min_step), "CVodeSetMinStep", ts);
-    check(CVodeSetNonlinConvCoef(mem, d.solver.newton_coefficient), "CVodeSetNonlinConvCoef", ts);
-    if (d.solver.max_order > 0) check(CVodeSetMaxOrd(mem, d.solver.max_order), "CVodeSetMaxOrd", ts);
-    check(CVodeSetStopTime(mem, c.segment_stop), "CVodeSetStopTime", ts);
-    if (bdf) {
-      S.A = SUNDenseMatrix(n_cv, n_cv, C.ctx);
-      use_compiled_matrix_kernels(S.A);
-      S.LS = make_dense_lu_solver(C.ctx);
-      check(CVodeSetLinearSolver(mem, S.LS, S.A), "CVodeSetLinearSolver", ts);
-      check(CVodeSetJacFn(mem, jacobian), "CVodeSetJacFn", ts);
-      P.local_blocks.clear();
-      if (d.solver.refresh_local_jacobians && refresh_local_blocks(P, mem, S.LS, ts, NV_DATA_S(y.v)))
-        check(CVodeSetLSetupFrequency(mem, kLocalRefreshSetupSteps), "CVodeSetLSetupFrequency", ts);
-    } else {
-      S.NLS = SUNNonlinSol_FixedPoint(y.v, 0, C.ctx);
-      check(CVodeSetNonlinearSolver(mem, S.NLS), "CVodeSetNonlinearSolver", ts);
-    }
+    set_up_forward(P, S.mem, C.ctx, c.start, y.v, atol_states.v, S.forward);
+    check(CVodeSetStopTime(S.mem, c.segment_stop), "CVodeSetStopTime", c.start);
   };
   auto add_forward_stats = [&](void* mem) {
     long v = 0;
@@ -344,8 +297,8 @@ RunResult run_cvodes_adjoint(const Diagram& d, const RunOptions& options) {
     // with 1/100 (for 50 % more backward time; docs/engine.md, Adjoint).
     constexpr double kLambdaAtolFraction = 0.01;
     const std::vector<double> nominal = state_nominals(d);
-    Vector lambda(N_VNew_Serial(std::max(nb, 1), C.ctx)), atol_b(N_VNew_Serial(std::max(nb, 1), C.ctx));
-    Vector grad(N_VNew_Serial(ns * nm, C.ctx)), atol_q(N_VNew_Serial(ns * nm, C.ctx));
+    OwnedVector lambda(N_VNew_Serial(std::max(nb, 1), C.ctx)), atol_b(N_VNew_Serial(std::max(nb, 1), C.ctx));
+    OwnedVector grad(N_VNew_Serial(ns * nm, C.ctx)), atol_q(N_VNew_Serial(ns * nm, C.ctx));
     N_VConst(0.0, lambda.v);
     N_VConst(d.solver.atol, atol_b.v);
     for (int m = 0; m < nm; ++m) {
@@ -358,7 +311,7 @@ RunResult run_cvodes_adjoint(const Diagram& d, const RunOptions& options) {
       }
     }
     std::vector<double> gradient(static_cast<size_t>(ns) * nm, 0.0);
-    Vector qB(N_VNew_Serial(ns * nm, C.ctx));
+    OwnedVector qB(N_VNew_Serial(ns * nm, C.ctx));
     const CpuClock backward_clock;
     long most_steps = 0;
     for (size_t k = chunks.size(); k-- > 0;) {
@@ -433,10 +386,7 @@ RunResult run_cvodes_adjoint(const Diagram& d, const RunOptions& options) {
   struct rusage usage {};
   if (getrusage(RUSAGE_SELF, &usage) == 0) as.peak_rss_bytes = 1024.0 * static_cast<double>(usage.ru_maxrss);
 
-  st.rtol = d.solver.rtol;
-  st.atol = d.solver.atol;
-  st.max_order = d.solver.max_order > 0 ? d.solver.max_order : highest_order(d.solver.method);
-  finish_stats(st, d.solver.method, clock.seconds(), d.time);
+  finish_cvodes_stats(st, d, clock.seconds());
   return result;
 }
 

@@ -1,12 +1,16 @@
 #include "engine/analysis/cvodes_problem.hpp"
 
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <limits>
 
 #include "engine/analysis/dense_lu_solver.hpp"
 #include "engine/analysis/sundials_kernels.hpp"
+#include "engine/analysis/timeline.hpp"
 #include "engine/framework/errors.hpp"
+#include "engine/framework/solver_methods.hpp"
 
 namespace dydp::engine::cvodes {
 
@@ -112,6 +116,57 @@ bool refresh_local_blocks(Problem& P, void* mem, SUNLinearSolver solver, double 
     ++P.local_refreshes;
   });
   return true;
+}
+
+void check_call(const Problem& P, int flag, const char* call, double t) {
+  if (flag >= 0) return;
+  throw SolverError(t, P.refusal.empty() ? "" : P.refusal.substr(0, P.refusal.find(':')),
+                    std::string(call) + " failed: " + flag_name(flag) +
+                        (P.cvodes_message.empty() ? "" : " (" + P.cvodes_message + ")") +
+                        (P.refusal.empty() ? "" : "; last refused point: " + P.refusal));
+}
+
+N_Vector state_tolerances(const Problem& P, const AbsoluteTolerances& atols, double atol, N_Vector like) {
+  N_Vector v = N_VClone(like);
+  N_VConst(atol, v);
+  std::copy_n(atols.states.data(), P.nx, NV_DATA_S(v));
+  std::copy_n(atols.quadratures.data(), P.nq, NV_DATA_S(v) + P.nx);
+  return v;
+}
+
+void set_up_forward(Problem& P, void* mem, SUNContext ctx, double t, N_Vector y, N_Vector atol, ForwardSolvers& s) {
+  const SolverSpec& solver = P.d.solver;
+  check_call(P, CVodeSetErrHandlerFn(mem, error_handler, &P), "CVodeSetErrHandlerFn", t);
+  check_call(P, CVodeInit(mem, rhs, t, y), "CVodeInit", t);
+  check_call(P, CVodeSetUserData(mem, &P), "CVodeSetUserData", t);
+  check_call(P, CVodeSVtolerances(mem, solver.rtol, atol), "CVodeSVtolerances", t);
+  check_call(P, CVodeSetMaxNumSteps(mem, solver.max_steps), "CVodeSetMaxNumSteps", t);
+  check_call(P, CVodeSetMinStep(mem, solver.min_step), "CVodeSetMinStep", t);
+  check_call(P, CVodeSetNonlinConvCoef(mem, solver.newton_coefficient), "CVodeSetNonlinConvCoef", t);
+  if (solver.max_order > 0) check_call(P, CVodeSetMaxOrd(mem, solver.max_order), "CVodeSetMaxOrd", t);
+  if (solver.method == "bdf") {
+    const sunindextype n = NV_LENGTH_S(y);
+    s.A = SUNDenseMatrix(n, n, ctx);
+    use_compiled_matrix_kernels(s.A);
+    s.LS = make_dense_lu_solver(ctx);
+    check_call(P, CVodeSetLinearSolver(mem, s.LS, s.A), "CVodeSetLinearSolver", t);
+    check_call(P, CVodeSetJacFn(mem, jacobian), "CVodeSetJacFn", t);
+    // With the local blocks refreshed at each set-up, a set-up every few steps (CVODES: 20)
+    // keeps them current; a factorisation costs a few percent of a step.
+    P.local_blocks.clear();
+    if (solver.refresh_local_jacobians && refresh_local_blocks(P, mem, s.LS, t, NV_DATA_S(y)))
+      check_call(P, CVodeSetLSetupFrequency(mem, kLocalRefreshSetupSteps), "CVodeSetLSetupFrequency", t);
+  } else {
+    s.NLS = SUNNonlinSol_FixedPoint(y, 0, ctx);
+    check_call(P, CVodeSetNonlinearSolver(mem, s.NLS), "CVodeSetNonlinearSolver", t);
+  }
+}
+
+void finish_cvodes_stats(RunStats& st, const Diagram& d, double cpu_seconds) {
+  st.rtol = d.solver.rtol;
+  st.atol = d.solver.atol;
+  st.max_order = d.solver.max_order > 0 ? d.solver.max_order : highest_order(d.solver.method);
+  finish_stats(st, d.solver.method, cpu_seconds, d.time);
 }
 
 }  // namespace dydp::engine::cvodes

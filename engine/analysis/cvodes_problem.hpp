@@ -1,11 +1,14 @@
 // The pieces of a CVODES run that the forward-sensitivity run (cvodes_solver.cpp) and the
 // adjoint run (cvodes_adjoint.cpp) share: the callbacks' problem (the diagram's evaluator, its
 // coloured Jacobian, what a refused point said), the right-hand side and Newton matrix callbacks,
-// and the refresh of the blocks' own diagonal Jacobian blocks.
+// the refresh of the blocks' own diagonal Jacobian blocks, the forward problem's set-up and the
+// statistics at the end.
 #pragma once
 
 #include <cvodes/cvodes.h>
 #include <nvector/nvector_serial.h>
+#include <sundials/sundials_linearsolver.h>
+#include <sundials/sundials_nonlinearsolver.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
 #include <algorithm>
@@ -14,6 +17,8 @@
 #include <utility>
 #include <vector>
 
+#include "engine/analysis/run_result.hpp"
+#include "engine/analysis/tolerances.hpp"
 #include "engine/evaluation/evaluator.hpp"
 #include "engine/evaluation/jacobian_colouring.hpp"
 #include "engine/framework/diagram.hpp"
@@ -89,5 +94,56 @@ void error_handler(int, const char* module, const char* function, char* msg, voi
 /// The blocks' own diagonal blocks of the Newton matrix refreshed at every factorisation
 /// (cvodes_problem.cpp); false when no block provides a local Jacobian.
 bool refresh_local_blocks(Problem& P, void* mem, SUNLinearSolver solver, double t0, const double* x0);
+
+/// An N_Vector destroyed with its owner.
+struct OwnedVector {
+  N_Vector v = nullptr;
+  OwnedVector() = default;
+  explicit OwnedVector(N_Vector w) : v(w) {}
+  OwnedVector(const OwnedVector&) = delete;
+  OwnedVector& operator=(OwnedVector&& o) noexcept {
+    std::swap(v, o.v);
+    return *this;
+  }
+  ~OwnedVector() {
+    if (v) N_VDestroy(v);
+  }
+};
+
+/// Throws SolverError at t when a SUNDIALS call failed (flag < 0), naming the call, the flag,
+/// CVODES' message and the last refused point.
+void check_call(const Problem& P, int flag, const char* call, double t);
+
+/// The per-state absolute tolerances of CVODES' vector [x; q] (atol times each one's nominal
+/// magnitude, tolerances.hpp; `atol` for the placeholder state of a stateless diagram), a new
+/// vector like `like` for the caller to destroy.
+N_Vector state_tolerances(const Problem& P, const AbsoluteTolerances& atols, double atol, N_Vector like);
+
+/// What a forward CVODES problem owns besides its memory (null where unused); an owner frees its
+/// CVODES memory before these (its destructor's body runs before its members').
+struct ForwardSolvers {
+  SUNMatrix A = nullptr;             ///< BDF: the dense Newton matrix
+  SUNLinearSolver LS = nullptr;      ///< BDF: its LU
+  SUNNonlinearSolver NLS = nullptr;  ///< Adams: the fixed-point iteration
+  ForwardSolvers() = default;
+  ForwardSolvers(const ForwardSolvers&) = delete;
+  ForwardSolvers& operator=(const ForwardSolvers&) = delete;
+  ~ForwardSolvers() {
+    if (LS) SUNLinSolFree(LS);
+    if (A) SUNMatDestroy(A);
+    if (NLS) SUNNonlinSolFree(NLS);
+  }
+};
+
+/// The forward problem on `mem` (from CVodeCreate), one code for the forward-sensitivity run and
+/// the adjoint's passes: the right-hand side from (t, y) with P as user data and CVODES' messages
+/// kept in P, the scene's rtol with the per-state `atol`, its limits (steps, minimum step, Newton
+/// coefficient, highest order), and for BDF the dense Newton matrix from the coloured Jacobian
+/// with the blocks' local Jacobian blocks refreshed at each set-up (a set-up every
+/// kLocalRefreshSetupSteps steps then), for Adams the fixed-point iteration.
+void set_up_forward(Problem& P, void* mem, SUNContext ctx, double t, N_Vector y, N_Vector atol, ForwardSolvers& s);
+
+/// The run's statistics at its end: the tolerances, the highest order and the CPU time.
+void finish_cvodes_stats(RunStats& st, const Diagram& d, double cpu_seconds);
 
 }  // namespace dydp::engine::cvodes

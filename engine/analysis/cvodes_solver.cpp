@@ -46,17 +46,13 @@ struct Sundials {
   N_Vector y = nullptr;
   N_Vector* ys = nullptr;
   int ns = 0;
-  SUNMatrix A = nullptr;
-  SUNLinearSolver LS = nullptr;
-  SUNNonlinearSolver NLS = nullptr, NLSsens = nullptr;
+  ForwardSolvers forward;
+  SUNNonlinearSolver NLSsens = nullptr;
 
   ~Sundials() {
     if (mem) CVodeFree(&mem);
     if (ys) N_VDestroyVectorArray(ys, ns);
     if (y) N_VDestroy(y);
-    if (LS) SUNLinSolFree(LS);
-    if (A) SUNMatDestroy(A);
-    if (NLS) SUNNonlinSolFree(NLS);
     if (NLSsens) SUNNonlinSolFree(NLSsens);
     if (ctx) SUNContext_Free(&ctx);
   }
@@ -79,11 +75,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
 
   Sundials S;
   S.ns = ns;
-  auto check = [&](int flag, const char* call) {
-    if (flag < 0)
-      throw SolverError(t0, "", std::string(call) + " failed: " + flag_name(flag) +
-                                    (P.cvodes_message.empty() ? "" : " (" + P.cvodes_message + ")"));
-  };
+  auto check = [&](int flag, const char* call) { check_call(P, flag, call, t0); };
   check(SUNContext_Create(nullptr, &S.ctx), "SUNContext_Create");
   S.y = N_VNew_Serial(n_cv, S.ctx);
   N_VEnableFusedOps_Serial(S.y, SUNTRUE);  // fewer passes over the sensitivity vectors
@@ -94,38 +86,11 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
 
   S.mem = CVodeCreate(bdf ? CV_BDF : CV_ADAMS, S.ctx);
   if (!S.mem) throw SolverError(t0, "", "CVodeCreate failed");
-  check(CVodeSetErrHandlerFn(S.mem, error_handler, &P), "CVodeSetErrHandlerFn");
-  check(CVodeInit(S.mem, rhs, t0, S.y), "CVodeInit");
-  check(CVodeSetUserData(S.mem, &P), "CVodeSetUserData");
   // One absolute tolerance per state: atol times its nominal magnitude (a pressure in Pa, a
   // position in m, a flow in m^3/s each judged in its own units).
   const AbsoluteTolerances atols = absolute_tolerances(d, d.solver.atol, ns);
-  N_Vector atol_states = N_VClone(S.y);
-  N_VConst(d.solver.atol, atol_states);
-  std::copy_n(atols.states.data(), nx, NV_DATA_S(atol_states));
-  std::copy_n(atols.quadratures.data(), nq, NV_DATA_S(atol_states) + nx);
-  const int sv_flag = CVodeSVtolerances(S.mem, d.solver.rtol, atol_states);
-  N_VDestroy(atol_states);
-  check(sv_flag, "CVodeSVtolerances");
-  check(CVodeSetMaxNumSteps(S.mem, d.solver.max_steps), "CVodeSetMaxNumSteps");
-  check(CVodeSetMinStep(S.mem, d.solver.min_step), "CVodeSetMinStep");
-  check(CVodeSetNonlinConvCoef(S.mem, d.solver.newton_coefficient), "CVodeSetNonlinConvCoef");
-  if (d.solver.max_order > 0) check(CVodeSetMaxOrd(S.mem, d.solver.max_order), "CVodeSetMaxOrd");
-  if (bdf) {
-    S.A = SUNDenseMatrix(n_cv, n_cv, S.ctx);
-    use_compiled_matrix_kernels(S.A);
-    S.LS = make_dense_lu_solver(S.ctx);
-    check(CVodeSetLinearSolver(S.mem, S.LS, S.A), "CVodeSetLinearSolver");
-    check(CVodeSetJacFn(S.mem, jacobian), "CVodeSetJacFn");
-    // With the local blocks refreshed at each set-up, a set-up every few steps (CVODES: 20)
-    // keeps them current; a factorisation costs a few percent of a step.
-    if (d.solver.refresh_local_jacobians && refresh_local_blocks(P, S.mem, S.LS, t0, NV_DATA_S(S.y))) {
-      check(CVodeSetLSetupFrequency(S.mem, kLocalRefreshSetupSteps), "CVodeSetLSetupFrequency");
-    }
-  } else {
-    S.NLS = SUNNonlinSol_FixedPoint(S.y, 0, S.ctx);
-    check(CVodeSetNonlinearSolver(S.mem, S.NLS), "CVodeSetNonlinearSolver");
-  }
+  const OwnedVector atol_states(state_tolerances(P, atols, d.solver.atol, S.y));  // CVODES keeps a copy
+  set_up_forward(P, S.mem, S.ctx, t0, S.y, atol_states.v, S.forward);
 
   if (ns > 0) {
     S.ys = N_VCloneVectorArray(ns, S.y);
@@ -287,10 +252,7 @@ RunResult run_cvodes(const Diagram& d, const RunOptions& options) {
   recorder.finish(q.data(), {dq.data(), std::max(nq, 1)});
   result.final_state.assign(NV_DATA_S(S.y), NV_DATA_S(S.y) + nx);
 
-  st.rtol = d.solver.rtol;
-  st.atol = d.solver.atol;
-  st.max_order = d.solver.max_order > 0 ? d.solver.max_order : highest_order(d.solver.method);
-  finish_stats(st, d.solver.method, clock.seconds(), d.time);
+  finish_cvodes_stats(st, d, clock.seconds());
   return result;
 }
 

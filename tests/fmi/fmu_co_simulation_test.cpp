@@ -180,9 +180,3 @@ TEST(FmuState, GetSetAndSerialisedStatesRollARunBackExactly) {
 
 }  // namespace
 }  // namespace dydp::test
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ::testing::AddGlobalTestEnvironment(new dydp::test::FmuFolder);
-  return RUN_ALL_TESTS();
-}

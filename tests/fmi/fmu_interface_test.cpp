@@ -453,9 +453,3 @@ TEST(FmuOutputs, TheCornerSubsystemGivesTheNativeForcesAtTheStart) {
 
 }  // namespace
 }  // namespace dydp::test
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ::testing::AddGlobalTestEnvironment(new dydp::test::FmuFolder);
-  return RUN_ALL_TESTS();
-}

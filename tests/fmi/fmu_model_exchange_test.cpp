@@ -387,9 +387,3 @@ INSTANTIATE_TEST_SUITE_P(
 
 }  // namespace
 }  // namespace dydp::test
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ::testing::AddGlobalTestEnvironment(new dydp::test::FmuFolder);
-  return RUN_ALL_TESTS();
-}
