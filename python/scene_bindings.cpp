@@ -9,7 +9,10 @@
 
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <vector>
 
+#include "engine/analysis/cvodes_adjoint.hpp"
 #include "engine/analysis/error_estimate.hpp"
 #include "engine/analysis/run.hpp"
 #include "engine/framework/diagram.hpp"
@@ -53,7 +56,8 @@ struct RunArrays {
 RunArrays arrays_of(const engine::Diagram& d, const engine::RunResult& r) {
   RunArrays a;
   const py::ssize_t n = static_cast<py::ssize_t>(r.t.size()), nsig = r.num_signals();
-  const py::ssize_t ns = static_cast<py::ssize_t>(r.sensitivity_names.size());
+  // adjoint: the objectives' gradients only, no signal sensitivities (shape (n, signals, 0))
+  const py::ssize_t ns = r.signal_sensitivities ? static_cast<py::ssize_t>(r.sensitivity_names.size()) : 0;
   a.t = py::array_t<double>(n);
   a.signals = py::array_t<double>({n, nsig});
   a.sensitivities = py::array_t<double>({n, nsig, ns});
@@ -103,9 +107,12 @@ engine::Diagram shadow_of(const Scene& scene) {
   return shadow;
 }
 
-RunArrays run_scene(Scene& scene, bool sensitivities, const py::object& progress, bool estimate) {
+RunArrays run_scene(Scene& scene, bool sensitivities, const py::object& progress, bool estimate, bool adjoint) {
   engine::RunOptions options;
   options.sensitivities = sensitivities;
+  options.adjoint = adjoint;
+  if (adjoint && !sensitivities)
+    throw engine::InputError("adjoint", 0, "sensitivities", "adjoint=True computes sensitivities: drop sensitivities=False");
   if (!progress.is_none()) {
     if (!PyCallable_Check(progress.ptr())) throw py::type_error("progress must be callable: progress(t)");
     options.progress = [&progress](double t) {
@@ -117,6 +124,19 @@ RunArrays run_scene(Scene& scene, bool sensitivities, const py::object& progress
   {
     py::gil_scoped_release released;
     const std::lock_guard<std::mutex> turn(*scene.running);
+    // adjoint: every declared parameter and direction for this run, the scene's own list after it
+    const std::vector<int> declared = scene.diagram.sensitivities;
+    struct Restore {
+      engine::Diagram& d;
+      const std::vector<int>& directions;
+      ~Restore() { d.set_sensitivities(directions); }
+    };
+    std::optional<Restore> restore;
+    if (adjoint) {
+      engine::check_adjoint_possible(scene.diagram);
+      restore.emplace(Restore{scene.diagram, declared});
+      engine::use_every_direction(scene.diagram);
+    }
     engine::start_at_equilibrium(scene.diagram);  // `initial: equilibrium`: its start first (the shadow's too)
     if (estimate) {
       engine::Diagram shadow = shadow_of(scene);
@@ -220,9 +240,11 @@ void add_scene_bindings(py::module_& m) {
           },
           py::arg("name"), py::arg("value"), "sets a scene parameter (checked against its range)")
       .def("run", &run_scene, py::arg("sensitivities") = true, py::arg("progress") = py::none(),
-           py::arg("estimate") = true,
+           py::arg("estimate") = true, py::arg("adjoint") = false,
            "Runs the scene (the GIL released); progress(t) is called at every output time; estimate: "
-           "a shadow run beside it estimates its error (stats['error_estimate'], as run.json). "
+           "a shadow run beside it estimates its error (stats['error_estimate'], as run.json); adjoint: "
+           "the objectives' gradients for every declared parameter and direction by the adjoint method "
+           "(one backward run; no signal sensitivities; stats['adjoint'] as run.json). "
            "Runs of one scene take turns; load a scene per thread to run in parallel.")
       .def("__repr__", [](const Scene& s) { return "<dydp.Scene " + s.diagram.scene_name + " from " + s.diagram.file + ">"; });
 
@@ -232,13 +254,13 @@ void add_scene_bindings(py::module_& m) {
   m.def(
       "run",
       [](const std::filesystem::path& path, const py::dict& overrides, bool sensitivities, const py::object& progress,
-         bool estimate) {
+         bool estimate, bool adjoint) {
         const std::unique_ptr<Scene> scene = load(path, overrides);
-        return run_scene(*scene, sensitivities, progress, estimate);
+        return run_scene(*scene, sensitivities, progress, estimate, adjoint);
       },
       py::arg("scene"), py::arg("overrides") = py::dict(), py::arg("sensitivities") = true,
-      py::arg("progress") = py::none(), py::arg("estimate") = true,
-      "load(scene, overrides).run(sensitivities, progress, estimate)");
+      py::arg("progress") = py::none(), py::arg("estimate") = true, py::arg("adjoint") = false,
+      "load(scene, overrides).run(sensitivities, progress, estimate, adjoint)");
 }
 
 }  // namespace dydp::python

@@ -66,20 +66,6 @@ bool split_range(const std::string& text, double& lo, double& hi, double& n) {
          engine::parse_number(b, hi) && engine::parse_number(c, n);
 }
 
-/// --adjoint: every declared parameter and direction that the blocks can differentiate.
-void use_every_direction(engine::Diagram& d) {
-  std::vector<int> directions;
-  for (int i = 0; i < static_cast<int>(d.parameters.size()); ++i) {
-    try {
-      engine::check_differentiable(d.nodes, d, {i});
-      directions.push_back(i);
-    } catch (const engine::InputError&) {
-      // drives a switching time or another parameter without a tangent: no gradient for it
-    }
-  }
-  d.set_sensitivities(directions);
-}
-
 int run_command(const RunArgs& args) {
   engine::Diagram d = engine::load_scene(args.scene, parse_sets(args.sets));
   engine::apply_solver_overrides(d, args.solver);
@@ -87,7 +73,7 @@ int run_command(const RunArgs& args) {
   if (args.adjoint) {
     if (args.no_sens) throw engine::InputError("--adjoint", 0, "--no-sens", "--adjoint computes sensitivities: drop --no-sens");
     engine::check_adjoint_possible(d);
-    use_every_direction(d);
+    engine::use_every_direction(d);
   }
 
   engine::RunOptions options;
