@@ -261,12 +261,10 @@ bool BlockLU::compute_rows(const double* a, Eigen::Index ld, const std::vector<i
       cols);
 }
 
-void BlockLU::solve(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs, double* x, Eigen::Index ldx) const {
+template <bool kTransposed>
+void BlockLU::apply_inverses(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs, double* x,
+                             Eigen::Index ldx) const {
   double* __restrict t = work_.data();
-  if (!inverted_) {
-    substitute(rhs, ldb, nrhs, x, ldx);
-    return;
-  }
   for (Eigen::Index c = 0; c < nrhs; ++c) {
     const double* bc = rhs + c * ldb;
     for (int i = 0; i < size_; ++i) t[i] = bc[i];
@@ -274,8 +272,10 @@ void BlockLU::solve(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs, doub
     for (const Block& b : blocks_) {
       const int k = static_cast<int>(b.rows.size());
       const double* __restrict inv = b.inverse.data();
-      const int* __restrict from = b.rows.data();
-      const int* __restrict to = b.cols.data();
+      // A^-1 takes the block's rows to its columns; A^-T its columns to its rows, the inverse
+      // read by columns
+      const int* __restrict from = kTransposed ? b.cols.data() : b.rows.data();
+      const int* __restrict to = kTransposed ? b.rows.data() : b.cols.data();
       double* __restrict z = t + size_;
       bool zero = true;
       for (int j = 0; j < k; ++j) zero = (z[j] = t[from[j]]) == 0.0 && zero;
@@ -285,11 +285,16 @@ void BlockLU::solve(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs, doub
       }
       for (int i = 0; i < k; ++i) {
         double sum = 0.0;
-        for (int j = 0; j < k; ++j) sum += inv[i * k + j] * z[j];
+        for (int j = 0; j < k; ++j) sum += (kTransposed ? inv[j * k + i] : inv[i * k + j]) * z[j];
         xc[to[i]] = sum;
       }
     }
   }
+}
+
+void BlockLU::solve(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs, double* x, Eigen::Index ldx) const {
+  if (inverted_) apply_inverses<false>(rhs, ldb, nrhs, x, ldx);
+  else substitute(rhs, ldb, nrhs, x, ldx);
 }
 
 void BlockLU::substitute(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs, double* x, Eigen::Index ldx) const {
@@ -310,27 +315,8 @@ void BlockLU::substitute(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs,
 
 void BlockLU::transpose_solve(const double* rhs, Eigen::Index ldb, Eigen::Index nrhs, double* x,
                               Eigen::Index ldx) const {
-  // y = A^-T b: the block inverse read by columns
   if (!inverted_) throw std::logic_error("BlockLU: transpose_solve before invert");
-  double* __restrict t = work_.data();
-  for (Eigen::Index c = 0; c < nrhs; ++c) {
-    const double* bc = rhs + c * ldb;
-    for (int i = 0; i < size_; ++i) t[i] = bc[i];
-    double* xc = x + c * ldx;
-    for (const Block& b : blocks_) {
-      const int k = static_cast<int>(b.rows.size());
-      const double* __restrict inv = b.inverse.data();
-      const int* __restrict from = b.cols.data();
-      const int* __restrict to = b.rows.data();
-      double* __restrict z = t + size_;
-      for (int i = 0; i < k; ++i) z[i] = t[from[i]];
-      for (int j = 0; j < k; ++j) {
-        double sum = 0.0;
-        for (int i = 0; i < k; ++i) sum += inv[i * k + j] * z[i];
-        xc[to[j]] = sum;
-      }
-    }
-  }
+  apply_inverses<true>(rhs, ldb, nrhs, x, ldx);
 }
 
 BlockLU::Matrix BlockLU::solve(const Matrix& b) const {

@@ -61,6 +61,9 @@ class BlockLU {
   // z := A_block^-1 b through L and U, z holding b in the factors' order (z[i] = b[order[i]])
   static void apply_factors(const Block& b, double* z);
   void substitute(const double* b, Eigen::Index ldb, Eigen::Index nrhs, double* x, Eigen::Index ldx) const;
+  // x = A^-1 b, or A^-T b (kTransposed), from the blocks' inverses
+  template <bool kTransposed>
+  void apply_inverses(const double* b, Eigen::Index ldb, Eigen::Index nrhs, double* x, Eigen::Index ldx) const;
   bool inverted_ = false;
   std::vector<Block> blocks_;
   // compute_rows' reads: block by block, entry t of its lu at a[gather_[start + t]], for the

@@ -184,6 +184,18 @@ class Loader {
   }
 
   void load(const YAML::Node& root) {
+    read_tree(root);
+    if (const YAML::Node cs = root["cuts"]) read_cuts(cs);
+    if (const YAML::Node fs = root["forces"]) read_forces(fs);
+    if (const YAML::Node ls = root["loads"]) read_loads(ls);
+    if (const YAML::Node ss = root["sensors"]) read_sensors(ss);
+    if (const YAML::Node js = root["jacobians"]) read_jacobians(js);
+    if (const YAML::Node ind = root["independent"]) read_independent(ind);
+  }
+
+  // The model's name, gravity, parameters, ground and bodies with their joints, the joints in
+  // parent-first order.
+  void read_tree(const YAML::Node& root) {
     check_keys(root, "model", {"model", "description", "gravity", "parameters", "ground", "bodies", "cuts",
                                "forces", "loads", "sensors", "jacobians", "independent"});
     if (root["model"]) m_.name = text(root["model"], "model");
@@ -307,206 +319,227 @@ class Loader {
       m_.order.push_back(j);
     };
     for (std::size_t j = 0; j < m_.joints.size(); ++j) visit(static_cast<int>(j));
+  }
 
-    if (const YAML::Node cs = root["cuts"]) {
-      for (std::size_t i = 0; i < cs.size(); ++i) {
-        const YAML::Node c = cs[i];
-        std::string field = "cuts[" + std::to_string(i) + "]";
-        check_keys(c, field, {"name", "type", "a", "b", "components", "length", "axis", "axis_a", "axis_b"});
-        Cut cut;
-        cut.name = c["name"] ? text(c["name"], field + ".name") : "cut" + std::to_string(i + 1);
-        field = "cuts." + cut.name;
-        const std::string type = c["type"] ? text(c["type"], field + ".type") : "";
-        if (!c["a"] || !c["b"]) fail(c, field, "needs points a and b (BODY.ANCHOR)");
-        cut.a = point(c["a"], field + ".a");
-        cut.b = point(c["b"], field + ".b");
-        if (type == "ball") {
-          cut.type = Cut::Type::Ball;
-          if (const YAML::Node comp = c["components"]) {
-            for (std::size_t k = 0; k < comp.size(); ++k) {
-              const std::string s = text(comp[k], field + ".components");
-              if (s != "x" && s != "y" && s != "z") fail(comp[k], field + ".components", "expected x, y or z");
-              cut.components.push_back(s[0] - 'x');
-            }
-          } else {
-            cut.components = {0, 1, 2};
+  // The cuts that close the loops (ball, distance, hinge).
+  void read_cuts(const YAML::Node& cs) {
+    for (std::size_t i = 0; i < cs.size(); ++i) {
+      const YAML::Node c = cs[i];
+      const Entry at =
+          entry(c, "cuts", i, {"name", "type", "a", "b", "components", "length", "axis", "axis_a", "axis_b"}, "cut");
+      const std::string& field = at.field;
+      const std::string& type = at.type;
+      Cut cut;
+      cut.name = at.name;
+      if (!c["a"] || !c["b"]) fail(c, field, "needs points a and b (BODY.ANCHOR)");
+      cut.a = point(c["a"], field + ".a");
+      cut.b = point(c["b"], field + ".b");
+      if (type == "ball") {
+        cut.type = Cut::Type::Ball;
+        if (const YAML::Node comp = c["components"]) {
+          for (std::size_t k = 0; k < comp.size(); ++k) {
+            const std::string s = text(comp[k], field + ".components");
+            if (s != "x" && s != "y" && s != "z") fail(comp[k], field + ".components", "expected x, y or z");
+            cut.components.push_back(s[0] - 'x');
           }
-        } else if (type == "distance") {
-          cut.type = Cut::Type::Distance;
-          if (!c["length"]) fail(c, field + ".length", "missing");
-          cut.length = value(c["length"], field + ".length");
-        } else if (type == "hinge") {
-          cut.type = Cut::Type::Hinge;
-          for (const char* key : {"components", "length"})
-            if (c[key]) fail(c[key], field + "." + key, "not a key of a hinge");
-          // `axis` for both bodies (frames parallel in the assembled position), or one each
-          auto body_axis = [&](const std::string& key) {
-            if (const YAML::Node own = c[key]) return hinge_axis(own, field + "." + key);
-            if (const YAML::Node both = c["axis"]) return hinge_axis(both, field + ".axis");
-            fail(c, field + "." + key, "missing (a hinge needs axis, or axis_a and axis_b: x, y, z or [x, y, z])");
-          };
-          cut.axis_a = body_axis("axis_a");
-          cut.axis_b = body_axis("axis_b");
-          cut.normals_a = hinge_normals(cut.axis_a);
         } else {
-          fail(c["type"] ? c["type"] : c, field + ".type", "expected ball, distance or hinge");
+          cut.components = {0, 1, 2};
         }
-        if (cut.type != Cut::Type::Hinge)
-          for (const char* key : {"axis", "axis_a", "axis_b"})
-            if (c[key]) fail(c[key], field + "." + key, "only a hinge takes " + std::string(key));
-        m_.cuts.push_back(cut);
+      } else if (type == "distance") {
+        cut.type = Cut::Type::Distance;
+        if (!c["length"]) fail(c, field + ".length", "missing");
+        cut.length = value(c["length"], field + ".length");
+      } else if (type == "hinge") {
+        cut.type = Cut::Type::Hinge;
+        for (const char* key : {"components", "length"})
+          if (c[key]) fail(c[key], field + "." + key, "not a key of a hinge");
+        // `axis` for both bodies (frames parallel in the assembled position), or one each
+        auto body_axis = [&](const std::string& key) {
+          if (const YAML::Node own = c[key]) return hinge_axis(own, field + "." + key);
+          if (const YAML::Node both = c["axis"]) return hinge_axis(both, field + ".axis");
+          fail(c, field + "." + key, "missing (a hinge needs axis, or axis_a and axis_b: x, y, z or [x, y, z])");
+        };
+        cut.axis_a = body_axis("axis_a");
+        cut.axis_b = body_axis("axis_b");
+        cut.normals_a = hinge_normals(cut.axis_a);
+      } else {
+        fail(c["type"] ? c["type"] : c, field + ".type", "expected ball, distance or hinge");
       }
+      if (cut.type != Cut::Type::Hinge)
+        for (const char* key : {"axis", "axis_a", "axis_b"})
+          if (c[key]) fail(c[key], field + "." + key, "only a hinge takes " + std::string(key));
+      m_.cuts.push_back(cut);
     }
+  }
 
-    if (const YAML::Node fs = root["forces"]) {
-      for (std::size_t i = 0; i < fs.size(); ++i) {
-        const YAML::Node f = fs[i];
-        std::string field = "forces[" + std::to_string(i) + "]";
-        check_keys(f, field, {"name", "type", "a", "b", "stiffness", "rest_length", "damping", "joint", "value"});
-        ForceElement e;
-        e.name = f["name"] ? text(f["name"], field + ".name") : "force" + std::to_string(i + 1);
-        field = "forces." + e.name;
-        const std::string type = f["type"] ? text(f["type"], field + ".type") : "";
-        if (type == "spring") {
-          e.type = ForceElement::Type::Spring;
-          if (!f["a"] || !f["b"]) fail(f, field, "needs points a and b");
-          e.a = point(f["a"], field + ".a");
-          e.b = point(f["b"], field + ".b");
-          e.stiffness = optional_value(f, "stiffness", field, 0.0);
-          e.rest_length = optional_value(f, "rest_length", field, 0.0);
-          e.damping = optional_value(f, "damping", field, 0.0);
-        } else if (type == "joint_force") {
-          e.type = ForceElement::Type::JointForce;
-          if (!f["joint"] || !f["value"]) fail(f, field, "needs joint and value");
-          e.joint = joint_index(f["joint"], field + ".joint");
-          e.value = value(f["value"], field + ".value");
-        } else {
-          fail(f["type"] ? f["type"] : f, field + ".type", "expected spring or joint_force");
-        }
-        m_.forces.push_back(e);
+  // The force elements (springs, joint forces).
+  void read_forces(const YAML::Node& fs) {
+    for (std::size_t i = 0; i < fs.size(); ++i) {
+      const YAML::Node f = fs[i];
+      const Entry at = entry(
+          f, "forces", i, {"name", "type", "a", "b", "stiffness", "rest_length", "damping", "joint", "value"}, "force");
+      const std::string& field = at.field;
+      const std::string& type = at.type;
+      ForceElement e;
+      e.name = at.name;
+      if (type == "spring") {
+        e.type = ForceElement::Type::Spring;
+        if (!f["a"] || !f["b"]) fail(f, field, "needs points a and b");
+        e.a = point(f["a"], field + ".a");
+        e.b = point(f["b"], field + ".b");
+        e.stiffness = optional_value(f, "stiffness", field, 0.0);
+        e.rest_length = optional_value(f, "rest_length", field, 0.0);
+        e.damping = optional_value(f, "damping", field, 0.0);
+      } else if (type == "joint_force") {
+        e.type = ForceElement::Type::JointForce;
+        if (!f["joint"] || !f["value"]) fail(f, field, "needs joint and value");
+        e.joint = joint_index(f["joint"], field + ".joint");
+        e.value = value(f["value"], field + ".value");
+      } else {
+        fail(f["type"] ? f["type"] : f, field + ".type", "expected spring or joint_force");
       }
+      m_.forces.push_back(e);
     }
+  }
 
-    if (const YAML::Node ls = root["loads"]) {
-      for (std::size_t i = 0; i < ls.size(); ++i) {
-        const YAML::Node l = ls[i];
-        std::string field = "loads[" + std::to_string(i) + "]";
-        check_keys(l, field, {"name", "type", "point", "body", "frame", "components", "a", "b", "sense",
-                              "reaction"});
-        Load load;
-        if (!l["name"]) fail(l, field, "missing name");
-        load.name = text(l["name"], field + ".name");
-        field = "loads." + load.name;
-        const std::string type = l["type"] ? text(l["type"], field + ".type") : "";
-        if (type == "force") {
-          load.type = Load::Type::Force;
-          if (!l["point"]) fail(l, field + ".point", "missing");
-          load.point = point(l["point"], field + ".point");
-        } else if (type == "torque") {
-          load.type = Load::Type::Torque;
-          if (!l["body"]) fail(l, field + ".body", "missing");
-          load.point.body = body_index(l["body"], text(l["body"], field + ".body"), field + ".body");
-          if (l["reaction"])
-            load.reaction = body_index(l["reaction"], text(l["reaction"], field + ".reaction"), field + ".reaction");
-        } else if (type == "link_force") {
-          load.type = Load::Type::LinkForce;
-          if (!l["a"] || !l["b"]) fail(l, field, "needs points a and b (BODY.ANCHOR)");
-          load.point = point(l["a"], field + ".a");
-          load.b = point(l["b"], field + ".b");
-          const std::string sense = l["sense"] ? text(l["sense"], field + ".sense") : "tension";
-          if (sense != "tension" && sense != "compression")
-            fail(l["sense"], field + ".sense", "expected tension or compression");
-          load.compression = sense == "compression";
-          for (const char* key : {"frame", "components", "point", "body", "reaction"})
-            if (l[key]) fail(l[key], field + "." + key, "not a key of a link force");
-        } else {
-          fail(l["type"] ? l["type"] : l, field + ".type", "expected force, torque or link_force");
-        }
-        if (load.type == Load::Type::Force && l["reaction"])
-          fail(l["reaction"], field + ".reaction", "only a torque takes a reaction body");
-        if (load.type != Load::Type::LinkForce) {
-          for (const char* key : {"a", "b", "sense"})
-            if (l[key]) fail(l[key], field + "." + key, "only a link force takes " + std::string(key));
-          if (l["components"]) load.components = components(l["components"], field + ".components", {"x", "y", "z"});
-        }
-        load.frame = frame(l, field);
-        m_.loads.push_back(load);
+  // The load ports (forces, torques, link forces).
+  void read_loads(const YAML::Node& ls) {
+    for (std::size_t i = 0; i < ls.size(); ++i) {
+      const YAML::Node l = ls[i];
+      const Entry at =
+          entry(l, "loads", i, {"name", "type", "point", "body", "frame", "components", "a", "b", "sense", "reaction"});
+      const std::string& field = at.field;
+      const std::string& type = at.type;
+      Load load;
+      load.name = at.name;
+      if (type == "force") {
+        load.type = Load::Type::Force;
+        if (!l["point"]) fail(l, field + ".point", "missing");
+        load.point = point(l["point"], field + ".point");
+      } else if (type == "torque") {
+        load.type = Load::Type::Torque;
+        if (!l["body"]) fail(l, field + ".body", "missing");
+        load.point.body = body_index(l["body"], text(l["body"], field + ".body"), field + ".body");
+        if (l["reaction"])
+          load.reaction = body_index(l["reaction"], text(l["reaction"], field + ".reaction"), field + ".reaction");
+      } else if (type == "link_force") {
+        load.type = Load::Type::LinkForce;
+        if (!l["a"] || !l["b"]) fail(l, field, "needs points a and b (BODY.ANCHOR)");
+        load.point = point(l["a"], field + ".a");
+        load.b = point(l["b"], field + ".b");
+        const std::string sense = l["sense"] ? text(l["sense"], field + ".sense") : "tension";
+        if (sense != "tension" && sense != "compression")
+          fail(l["sense"], field + ".sense", "expected tension or compression");
+        load.compression = sense == "compression";
+        for (const char* key : {"frame", "components", "point", "body", "reaction"})
+          if (l[key]) fail(l[key], field + "." + key, "not a key of a link force");
+      } else {
+        fail(l["type"] ? l["type"] : l, field + ".type", "expected force, torque or link_force");
       }
+      if (load.type == Load::Type::Force && l["reaction"])
+        fail(l["reaction"], field + ".reaction", "only a torque takes a reaction body");
+      if (load.type != Load::Type::LinkForce) {
+        for (const char* key : {"a", "b", "sense"})
+          if (l[key]) fail(l[key], field + "." + key, "only a link force takes " + std::string(key));
+        if (l["components"]) load.components = components(l["components"], field + ".components", {"x", "y", "z"});
+      }
+      load.frame = frame(l, field);
+      m_.loads.push_back(load);
     }
+  }
 
-    if (const YAML::Node ss = root["sensors"]) {
-      for (std::size_t i = 0; i < ss.size(); ++i) {
-        const YAML::Node s = ss[i];
-        std::string field = "sensors[" + std::to_string(i) + "]";
-        check_keys(s, field, {"name", "type", "point", "body", "a", "b", "frame", "joint", "components", "reference",
-                              "sense"});
-        Sensor sensor;
-        if (!s["name"]) fail(s, field, "missing name");
-        sensor.name = text(s["name"], field + ".name");
-        field = "sensors." + sensor.name;
-        const std::string type = s["type"] ? text(s["type"], field + ".type") : "";
-        static const std::map<std::string, Sensor::Type> types{{"position", Sensor::Type::Position},
-            {"velocity", Sensor::Type::Velocity}, {"acceleration", Sensor::Type::Acceleration},
-            {"length", Sensor::Type::Length}, {"joint", Sensor::Type::Joint},
-            {"angular_velocity", Sensor::Type::AngularVelocity}};
-        const auto t = types.find(type);
-        if (t == types.end()) fail(s["type"] ? s["type"] : s, field + ".type",
-                                   "expected position, velocity, acceleration, angular_velocity, length or joint");
-        sensor.type = t->second;
-        if (sensor.type != Sensor::Type::Length)
-          for (const char* key : {"reference", "sense"})
-            if (s[key]) fail(s[key], field + "." + key, "only a length sensor takes " + std::string(key));
-        if (sensor.type == Sensor::Type::Length) {
-          if (!s["a"] || !s["b"]) fail(s, field, "needs points a and b");
-          sensor.a = point(s["a"], field + ".a");
-          sensor.b = point(s["b"], field + ".b");
-          if (s["reference"]) sensor.reference = value(s["reference"], field + ".reference");
-          const std::string sense = s["sense"] ? text(s["sense"], field + ".sense") : "extension";
-          if (sense != "extension" && sense != "compression")
-            fail(s["sense"], field + ".sense", "expected extension or compression");
-          sensor.compression = sense == "compression";
-        } else if (sensor.type == Sensor::Type::AngularVelocity) {
-          if (!s["body"]) fail(s, field + ".body", "missing");
-          sensor.a.body = body_index(s["body"], text(s["body"], field + ".body"), field + ".body");
-          sensor.frame = frame(s, field);
-        } else if (sensor.type == Sensor::Type::Joint) {
-          if (!s["joint"]) fail(s, field + ".joint", "missing");
-          sensor.joint = joint_index(s["joint"], field + ".joint");
-        } else {
-          if (!s["point"]) fail(s, field + ".point", "missing");
-          sensor.a = point(s["point"], field + ".point");
-          sensor.frame = frame(s, field);
-        }
-        std::vector<std::string> names{"x", "y", "z"};
-        if (sensor.type == Sensor::Type::Length) names = {"length", "rate"};
-        if (sensor.type == Sensor::Type::Joint) names = {"q", "qd", "qdd"};
-        if (s["components"]) {
-          sensor.components = components(s["components"], field + ".components", names);
-        } else {
-          for (int c = 0; c < sensor.full_width(); ++c) sensor.components.push_back(c);
-        }
-        m_.sensors.push_back(sensor);
+  // The sensors.
+  void read_sensors(const YAML::Node& ss) {
+    for (std::size_t i = 0; i < ss.size(); ++i) {
+      const YAML::Node s = ss[i];
+      const Entry at = entry(
+          s, "sensors", i, {"name", "type", "point", "body", "a", "b", "frame", "joint", "components", "reference", "sense"});
+      const std::string& field = at.field;
+      const std::string& type = at.type;
+      Sensor sensor;
+      sensor.name = at.name;
+      static const std::map<std::string, Sensor::Type> types{{"position", Sensor::Type::Position},
+          {"velocity", Sensor::Type::Velocity}, {"acceleration", Sensor::Type::Acceleration},
+          {"length", Sensor::Type::Length}, {"joint", Sensor::Type::Joint},
+          {"angular_velocity", Sensor::Type::AngularVelocity}};
+      const auto t = types.find(type);
+      if (t == types.end()) fail(s["type"] ? s["type"] : s, field + ".type",
+                                 "expected position, velocity, acceleration, angular_velocity, length or joint");
+      sensor.type = t->second;
+      if (sensor.type != Sensor::Type::Length)
+        for (const char* key : {"reference", "sense"})
+          if (s[key]) fail(s[key], field + "." + key, "only a length sensor takes " + std::string(key));
+      if (sensor.type == Sensor::Type::Length) {
+        if (!s["a"] || !s["b"]) fail(s, field, "needs points a and b");
+        sensor.a = point(s["a"], field + ".a");
+        sensor.b = point(s["b"], field + ".b");
+        if (s["reference"]) sensor.reference = value(s["reference"], field + ".reference");
+        const std::string sense = s["sense"] ? text(s["sense"], field + ".sense") : "extension";
+        if (sense != "extension" && sense != "compression")
+          fail(s["sense"], field + ".sense", "expected extension or compression");
+        sensor.compression = sense == "compression";
+      } else if (sensor.type == Sensor::Type::AngularVelocity) {
+        if (!s["body"]) fail(s, field + ".body", "missing");
+        sensor.a.body = body_index(s["body"], text(s["body"], field + ".body"), field + ".body");
+        sensor.frame = frame(s, field);
+      } else if (sensor.type == Sensor::Type::Joint) {
+        if (!s["joint"]) fail(s, field + ".joint", "missing");
+        sensor.joint = joint_index(s["joint"], field + ".joint");
+      } else {
+        if (!s["point"]) fail(s, field + ".point", "missing");
+        sensor.a = point(s["point"], field + ".point");
+        sensor.frame = frame(s, field);
       }
+      std::vector<std::string> names{"x", "y", "z"};
+      if (sensor.type == Sensor::Type::Length) names = {"length", "rate"};
+      if (sensor.type == Sensor::Type::Joint) names = {"q", "qd", "qdd"};
+      if (s["components"]) {
+        sensor.components = components(s["components"], field + ".components", names);
+      } else {
+        for (int c = 0; c < sensor.full_width(); ++c) sensor.components.push_back(c);
+      }
+      m_.sensors.push_back(sensor);
     }
+  }
 
-    if (const YAML::Node js = root["jacobians"]) {
-      for (std::size_t i = 0; i < js.size(); ++i) {
-        const YAML::Node j = js[i];
-        const std::string field = "jacobians[" + std::to_string(i) + "]";
-        check_keys(j, field, {"name", "point"});
-        if (!j["name"] || !j["point"]) fail(j, field, "needs name and point");
-        m_.jacobians.push_back({text(j["name"], field + ".name"), point(j["point"], field + ".point")});
-      }
+  // The point Jacobians written in extenso.
+  void read_jacobians(const YAML::Node& js) {
+    for (std::size_t i = 0; i < js.size(); ++i) {
+      const YAML::Node j = js[i];
+      const std::string field = "jacobians[" + std::to_string(i) + "]";
+      check_keys(j, field, {"name", "point"});
+      if (!j["name"] || !j["point"]) fail(j, field, "needs name and point");
+      m_.jacobians.push_back({text(j["name"], field + ".name"), point(j["point"], field + ".point")});
     }
+  }
 
-    if (const YAML::Node ind = root["independent"]) {
-      if (!ind.IsSequence()) fail(ind, "independent", "expected a list of joint names");
-      for (std::size_t i = 0; i < ind.size(); ++i) {
-        const int k = joint_index(ind[i], "independent");
-        if (m_.joints[k].driven) fail(ind[i], "independent", "a driven joint cannot be independent");
-        m_.independent.push_back(k);
-      }
+  // The independent coordinates the model names.
+  void read_independent(const YAML::Node& ind) {
+    if (!ind.IsSequence()) fail(ind, "independent", "expected a list of joint names");
+    for (std::size_t i = 0; i < ind.size(); ++i) {
+      const int k = joint_index(ind[i], "independent");
+      if (m_.joints[k].driven) fail(ind[i], "independent", "a driven joint cannot be independent");
+      m_.independent.push_back(k);
     }
+  }
+
+  // The start of an entry of a list section: its keys checked, its name (`fallback` and its number
+  // when it has none and a fallback is given; required otherwise), its field for messages
+  // ("cuts.NAME") and its type ("" when it has none).
+  struct Entry {
+    std::string name, field, type;
+  };
+  Entry entry(const YAML::Node& node, const std::string& section, std::size_t i,
+              std::initializer_list<const char*> keys, const char* fallback = nullptr) const {
+    const std::string at = section + "[" + std::to_string(i) + "]";
+    check_keys(node, at, keys);
+    Entry e;
+    if (node["name"]) e.name = text(node["name"], at + ".name");
+    else if (fallback) e.name = fallback + std::to_string(i + 1);
+    else fail(node, at, "missing name");
+    e.field = section + "." + e.name;
+    e.type = node["type"] ? text(node["type"], e.field + ".type") : "";
+    return e;
   }
 
  private:
