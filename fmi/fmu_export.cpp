@@ -65,11 +65,20 @@ ExportSummary export_fmu(const ExportOptions& o) {
   options.generation_date = now_iso8601();
   summary.model_description = model_description_xml(d, t, options);
 
-  // The resources: the scene and every file its blocks were written in (subsystems), under
-  // resources/model/ at their places relative to the folder that holds them all.
+  // The resources: the scene, every file its blocks were written in (subsystems) and every file
+  // a block reads (recordings, tables), under resources/model/ at their places relative to the
+  // folder that holds them all, so that the scene's relative paths hold inside the FMU. A path
+  // written absolute would point outside it: refused.
   std::set<std::string> files = {fs::absolute(e.scene_file).lexically_normal().string()};
-  for (const engine::Node& n : d.nodes)
+  for (const engine::Node& n : d.nodes) {
     if (!n.file.empty()) files.insert(fs::absolute(n.file).lexically_normal().string());
+    if (!n.settings) continue;
+    for (const std::string& key : n.settings->files_read()) {
+      if (fs::path(n.settings->text(key)).is_absolute())
+        n.settings->fail(key, "an FMU carries the files its scene reads: write this path relative to the scene");
+      files.insert(fs::absolute(n.settings->path(key)).lexically_normal().string());
+    }
+  }
   fs::path root = fs::path(*files.begin()).parent_path();
   for (const std::string& f : files)
     while (fs::path(f).lexically_relative(root).string().rfind("..", 0) == 0) root = root.parent_path();

@@ -67,6 +67,7 @@ std::vector<std::string> BlockSettings::texts(const std::string& name) const {
 
 std::string BlockSettings::path(const std::string& name) const {
   std::filesystem::path p(text(name));
+  files_read_.insert(name);
   if (p.is_absolute()) return p.string();
   return (std::filesystem::path(file(name)).parent_path() / p).lexically_normal().string();
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -38,8 +39,11 @@ class BlockSettings {
   std::vector<double> numbers(const std::string& name) const;
   std::vector<std::string> texts(const std::string& name) const;
 
-  /// A path relative to the scene file's folder, as an absolute or scene-relative path.
+  /// A path relative to the scene file's folder, as an absolute or scene-relative path. The
+  /// setting is remembered as one that names a file (files_read).
   std::string path(const std::string& name) const;
+  /// The settings the block read as paths (a recording, a table): an FMU export bundles their files.
+  const std::set<std::string>& files_read() const { return files_read_; }
 
   /// Throws InputError at the setting's line ("file:line: block.name: message").
   [[noreturn]] void fail(const std::string& name, const std::string& message) const;
@@ -56,6 +60,7 @@ class BlockSettings {
   std::string block_, file_;
   int line_;
   std::map<std::string, Value> values_;
+  mutable std::set<std::string> files_read_;  ///< setting names; the block reads them while it is made
 };
 
 }  // namespace dydp::engine

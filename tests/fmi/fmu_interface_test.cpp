@@ -451,5 +451,52 @@ TEST(FmuOutputs, TheCornerSubsystemGivesTheNativeForcesAtTheStart) {
   f.fmi3FreeInstance(inst);
 }
 
+TEST(FmuExport, TheFilesASceneReadsTravelInTheFmu) {
+  // A scene reading a recording through a relative path (data/curve.csv): the FMU carries the
+  // file at its place beside the scene, and the FMU, unpacked elsewhere, reads it there.
+  const fs::path folder = FmuFolder::path() / "table_scene";
+  fs::create_directories(folder / "data");
+  std::ofstream(folder / "data" / "curve.csv") << "t,y\n0.0,1.0\n1.0,3.0\n2.0,2.0\n";
+  const std::string scene = R"(scene: table_scene
+time: {stop: 2.0, output_step: 0.1}
+blocks:
+  curve: {type: source.table, file: data/curve.csv, column: y}
+outputs: [curve.y]
+)";
+  std::ofstream(folder / "table.yaml") << scene;
+  auto fmu = load_fmu((folder / "table.yaml").string(), "table_scene", "files");
+  const auto entries = fmi::archive_entries((FmuFolder::path() / "table_scene.fmu").string());
+  EXPECT_TRUE(has(entries, "resources/model/table.yaml"));
+  EXPECT_TRUE(has(entries, "resources/model/data/curve.csv"));
+  fs::remove_all(folder);  // the FMU reads its own copy
+  const Fmi3Functions& f = fmu->f();
+  fmi3Instance inst = fmu->instantiate_cs();
+  ASSERT_NE(inst, nullptr) << fmu->last_error();
+  ASSERT_EQ(f.fmi3EnterInitializationMode(inst, false, 0.0, 0.0, false, 0.0), fmi3OK) << fmu->last_error();
+  ASSERT_EQ(f.fmi3ExitInitializationMode(inst), fmi3OK) << fmu->last_error();
+  const auto outputs = fmu->description().of("output");
+  ASSERT_EQ(outputs.size(), 1u);
+  fmi3Boolean b = false;
+  fmi3Float64 last = 0.0;
+  ASSERT_EQ(f.fmi3DoStep(inst, 0.0, 0.5, false, &b, &b, &b, &last), fmi3OK) << fmu->last_error();
+  double y = 0.0;
+  ASSERT_EQ(f.fmi3GetFloat64(inst, outputs.data(), 1, &y, 1), fmi3OK);
+  EXPECT_NEAR(y, 2.0, 1e-12);  // halfway between the rows at 0 and 1 s
+  ASSERT_EQ(f.fmi3DoStep(inst, 0.5, 1.0, false, &b, &b, &b, &last), fmi3OK) << fmu->last_error();
+  ASSERT_EQ(f.fmi3GetFloat64(inst, outputs.data(), 1, &y, 1), fmi3OK);
+  EXPECT_NEAR(y, 2.5, 1e-12);
+  f.fmi3FreeInstance(inst);
+}
+
+TEST(FmuExport, AnAbsolutePathToARecordingIsRefusedAtItsLine) {
+  const fs::path csv = FmuFolder::path() / "absolute_curve.csv";
+  std::ofstream(csv) << "t,y\n0.0,1.0\n1.0,3.0\n";
+  const std::string message = export_error("absolute_path", "scene: absolute_path\ntime: {stop: 1.0, output_step: 0.1}\n"
+                                                            "blocks:\n  curve:\n    type: source.table\n    file: " +
+                                                                csv.string() + "\n    column: y\noutputs: [curve.y]\n");
+  EXPECT_NE(message.find(":6: curve.file: "), std::string::npos) << message;
+  EXPECT_NE(message.find("write this path relative to the scene"), std::string::npos) << message;
+}
+
 }  // namespace
 }  // namespace dydp::test
