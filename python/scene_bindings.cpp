@@ -135,7 +135,7 @@ RunArrays run_scene(Scene& scene, bool sensitivities, const py::object& progress
     if (adjoint) {
       engine::check_adjoint_possible(scene.diagram);
       restore.emplace(Restore{scene.diagram, declared});
-      engine::use_every_direction(scene.diagram);
+      scene.diagram.set_sensitivities(engine::differentiable_parameters(scene.diagram));
     }
     engine::start_at_equilibrium(scene.diagram);  // `initial: equilibrium`: its start first (the shadow's too)
     if (estimate) {

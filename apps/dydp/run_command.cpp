@@ -73,7 +73,7 @@ int run_command(const RunArgs& args) {
   if (args.adjoint) {
     if (args.no_sens) throw engine::InputError("--adjoint", 0, "--no-sens", "--adjoint computes sensitivities: drop --no-sens");
     engine::check_adjoint_possible(d);
-    engine::use_every_direction(d);
+    d.set_sensitivities(engine::differentiable_parameters(d));  // every declared one that has a tangent
   }
 
   engine::RunOptions options;

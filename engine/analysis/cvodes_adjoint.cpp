@@ -158,19 +158,6 @@ void check_adjoint_possible(const Diagram& d) {
   }
 }
 
-void use_every_direction(Diagram& d) {
-  std::vector<int> directions;
-  for (int i = 0; i < static_cast<int>(d.parameters.size()); ++i) {
-    try {
-      check_differentiable(d.nodes, d, {i});
-      directions.push_back(i);
-    } catch (const InputError&) {
-      // drives a switching time or another parameter without a tangent: no gradient for it
-    }
-  }
-  d.set_sensitivities(directions);
-}
-
 RunResult run_cvodes_adjoint(const Diagram& d, const RunOptions& options) {
   check_adjoint_possible(d);
   const bool bdf = d.solver.method == "bdf";

@@ -17,9 +17,4 @@ RunResult run_cvodes_adjoint(const Diagram& d, const RunOptions& options);
 /// Throws InputError when d cannot be run by the adjoint method (its solver, its objectives).
 void check_adjoint_possible(const Diagram& d);
 
-/// Makes every declared parameter and direction that the blocks can differentiate a sensitivity
-/// direction of d (those that drive a switching time, or another setting without a tangent, are
-/// left out): what `dydp run --adjoint` and the Python module's run(adjoint=True) differentiate.
-void use_every_direction(Diagram& d);
-
 }  // namespace dydp::engine

@@ -185,6 +185,12 @@ class Diagram {
 /// cannot differentiate.
 void check_differentiable(const std::vector<Node>& nodes, const Diagram& d, const std::vector<int>& directions);
 
+/// The scene parameters (and directions) that every block they drive can differentiate, in the
+/// scene's order: what the linear analyses give derivatives for, and what `--adjoint` takes as
+/// its directions (those that drive a switching time or another setting without a tangent are
+/// left out).
+std::vector<int> differentiable_parameters(const Diagram& d);
+
 /// Loads a scene file; overrides are --set NAME=VALUE pairs for scene parameters;
 /// setting_overrides (SETTING, VALUE) replace that setting in every block whose type declares
 /// it (replay: the recorded input file). Throws InputError on bad input.

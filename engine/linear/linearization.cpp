@@ -11,18 +11,6 @@
 
 namespace dydp::engine {
 
-std::vector<int> differentiable_parameters(const Diagram& d) {
-  std::vector<int> out;
-  for (int i = 0; i < static_cast<int>(d.parameters.size()); ++i) {
-    try {
-      check_differentiable(d.nodes, d, {i});
-      out.push_back(i);
-    } catch (const InputError&) {
-    }
-  }
-  return out;
-}
-
 std::vector<std::pair<int, double>> held_signals(const Diagram& d, const std::vector<std::string>& specs,
                                                  const std::string& field) {
   std::vector<std::pair<int, double>> out;

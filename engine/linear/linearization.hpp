@@ -30,10 +30,6 @@ struct LinearModel {
 std::vector<std::pair<int, double>> held_signals(const Diagram& d, const std::vector<std::string>& specs,
                                                  const std::string& field);
 
-/// The scene parameters (and directions) whose derivatives the linear analyses give: all of
-/// them that every block they drive can differentiate, in the scene's order.
-std::vector<int> differentiable_parameters(const Diagram& d);
-
 /// d(xdot)/dx at (t, x) with the signals at `held` offsets held (their tangents zero): n x n.
 Eigen::MatrixXd state_jacobian(Evaluator& e, int num_states, double t, const std::vector<double>& x,
                                const std::vector<int>& held = {});

@@ -271,6 +271,18 @@ void check_differentiable(const std::vector<Node>& nodes, const Diagram& d, cons
                              d.parameters[n.p_scene[j]].name + "'");
 }
 
+std::vector<int> differentiable_parameters(const Diagram& d) {
+  std::vector<int> out;
+  for (int i = 0; i < static_cast<int>(d.parameters.size()); ++i) {
+    try {
+      check_differentiable(d.nodes, d, {i});
+      out.push_back(i);
+    } catch (const InputError&) {
+    }
+  }
+  return out;
+}
+
 void Diagram::set_sensitivities(const std::vector<int>& directions) {
   check_differentiable(nodes, *this, directions);
   sensitivities = directions;
