@@ -167,6 +167,22 @@ bool reads_acceleration(const mbs::Sensor& sensor) {
   return sensor.type == mbs::Sensor::Type::Acceleration || (sensor.type == mbs::Sensor::Type::Joint && reads_qdd);
 }
 
+// Items of the given sizes in `bins` bins of about equal total: the largest first into the bin
+// with the least so far; each bin's items in their own order.
+std::vector<std::vector<std::size_t>> balanced(const std::vector<std::size_t>& sizes, std::size_t bins) {
+  std::vector<std::size_t> order(sizes.size()), load(bins, 0);
+  for (std::size_t b = 0; b < order.size(); ++b) order[b] = b;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return sizes[a] > sizes[b]; });
+  std::vector<std::vector<std::size_t>> members(bins);
+  for (std::size_t b : order) {
+    const auto bin = static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+    load[bin] += sizes[b];
+    members[bin].push_back(b);
+  }
+  for (auto& m : members) std::sort(m.begin(), m.end());
+  return members;
+}
+
 }  // namespace
 
 MbsGeneration generate_mbs(const std::string& model_path, const GenerationOptions& options) {
@@ -332,21 +348,11 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
       for (const auto& block : f.blocks) text += block.definition;
       measure_text(text, result.functions.back());
       tangent_groups_tu.push_back(std::move(f.entry));
-      // the largest block first into the file with the fewest assignments so far
-      std::vector<std::size_t> order(f.blocks.size()), load(kTangentBlockFiles, 0);
-      for (std::size_t b = 0; b < order.size(); ++b) order[b] = b;
-      auto size = [&](std::size_t b) { return grouped.blocks[b].assignments_end - grouped.blocks[b].assignments_begin; };
-      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return size(a) > size(b); });
-      std::vector<std::vector<std::size_t>> members(kTangentBlockFiles);
-      for (std::size_t b : order) {
-        const auto file = static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
-        load[file] += size(b);
-        members[file].push_back(b);
-      }
-      for (std::size_t file = 0; file < members.size(); ++file) {
-        std::sort(members[file].begin(), members[file].end());
+      std::vector<std::size_t> sizes;
+      for (const TangentBlock& block : grouped.blocks) sizes.push_back(block.assignments_end - block.assignments_begin);
+      const std::vector<std::vector<std::size_t>> members = balanced(sizes, kTangentBlockFiles);
+      for (std::size_t file = 0; file < members.size(); ++file)
         for (std::size_t b : members[file]) tangent_block_files[file].push_back(std::move(f.blocks[b]));
-      }
       tangent_groups = static_cast<int>(kept.size());
       for (std::size_t g = 0; g < kept.size(); ++g)
         for (int c : kept[g]) tangent_group[c] = static_cast<int>(g);
