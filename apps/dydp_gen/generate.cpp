@@ -17,6 +17,16 @@ namespace dydp::gen {
 using namespace dydp::symbolic;
 
 void write_atomically(const std::filesystem::path& path, const std::string& text) {
+  // A file that already holds the text keeps its time stamp, so that the build (ninja's restat)
+  // recompiles only the generated files that changed when the generator is rebuilt.
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (in) {
+      std::ostringstream existing;
+      existing << in.rdbuf();
+      if (existing.str() == text) return;
+    }
+  }
   const std::filesystem::path temporary = path.string() + ".tmp";
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
