@@ -49,7 +49,7 @@ struct ModelLists {
   std::unique_ptr<symbolic::EquationList> inertial;
   // The entries of M by composite inertias: outputs named M[i,k] (k = i and every ancestor of
   // joint i), the structurally nonzero entries; null for trees too deep for it (see
-  // newton_euler.cpp), which use the inertial pass's tangent.
+  // kMassEntriesPerCoordinate in newton_euler_generator.hpp), which use the inertial pass's tangent.
   std::unique_ptr<symbolic::EquationList> mass_matrix;
   // The same entries as loops, for the trees that have no mass_matrix.
   std::unique_ptr<MassLoops> mass_loops;
