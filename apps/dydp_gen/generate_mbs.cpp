@@ -1,11 +1,12 @@
-// dydp-gen for multibody models (see generate_mbs.hpp).
+// dydp-gen for multibody models (see generate_mbs.hpp): the model's functions, built in order and
+// written by translation unit; the descriptor is model_descriptor.cpp's.
 #include "generate_mbs.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <sstream>
 
 #include "mass_loops_cpp.hpp"
+#include "model_descriptor.hpp"
 #include "symbolic/compact.hpp"
 #include "symbolic/differentiate.hpp"
 #include "symbolic/eliminate.hpp"
@@ -20,49 +21,6 @@ namespace dydp::gen {
 namespace {
 
 using namespace dydp::symbolic;
-
-std::string string_array(const std::string& name, const std::vector<std::string>& items) {
-  std::string s = "const char* const " + name + "[] = {";
-  for (std::size_t k = 0; k < items.size(); ++k) s += std::string(k % 6 ? "" : "\n    ") + "\"" + items[k] + "\", ";
-  if (items.empty()) s += "nullptr";
-  return s + "};\n";
-}
-
-/// The SI unit of a sensor port; components of different units are listed, comma-separated.
-std::string sensor_unit(const mbs::Model& model, const mbs::Sensor& sensor) {
-  using Type = mbs::Sensor::Type;
-  std::vector<std::string> units;
-  for (int c : sensor.components) {
-    std::string u;
-    switch (sensor.type) {
-      case Type::Position: u = "m"; break;
-      case Type::Velocity: u = "m/s"; break;
-      case Type::Acceleration: u = "m/s^2"; break;
-      case Type::AngularVelocity: u = "rad/s"; break;
-      case Type::Length: u = c == 0 ? "m" : "m/s"; break;
-      case Type::Joint: {
-        const bool rotation = mbs::is_revolute(model.joints[sensor.joint].type);
-        u = std::string(rotation ? "rad" : "m") + (c == 0 ? "" : c == 1 ? "/s" : "/s^2");
-        break;
-      }
-    }
-    if (std::find(units.begin(), units.end(), u) == units.end()) units.push_back(u);
-  }
-  std::string out;
-  for (const auto& u : units) out += (out.empty() ? "" : ", ") + u;
-  return out;
-}
-
-template <class T>
-std::string number_array(const std::string& type, const std::string& name, const std::vector<T>& items) {
-  std::ostringstream s;
-  s.precision(17);
-  s << "const " << type << " " << name << "[] = {";
-  for (std::size_t k = 0; k < items.size(); ++k) s << (k % 8 ? "" : "\n    ") << items[k] << ", ";
-  if (items.empty()) s << "0";
-  s << "};\n";
-  return s.str();
-}
 
 // A tangent list without its primal outputs: what only the derivatives read stays of the
 // primal part (elimination drops the rest).
@@ -160,13 +118,6 @@ std::vector<std::vector<int>> coupled_coordinates(const mbs::Model& model, const
   return groups;
 }
 
-// Whether a sensor's outputs depend on qdd: acceleration sensors, and joint sensors that report
-// the joint's acceleration.
-bool reads_acceleration(const mbs::Sensor& sensor) {
-  const bool reads_qdd = std::find(sensor.components.begin(), sensor.components.end(), 2) != sensor.components.end();
-  return sensor.type == mbs::Sensor::Type::Acceleration || (sensor.type == mbs::Sensor::Type::Joint && reads_qdd);
-}
-
 // Items of the given sizes in `bins` bins of about equal total: the largest first into the bin
 // with the least so far; each bin's items in their own order.
 std::vector<std::vector<std::size_t>> balanced(const std::vector<std::size_t>& sizes, std::size_t bins) {
@@ -183,62 +134,101 @@ std::vector<std::vector<std::size_t>> balanced(const std::vector<std::size_t>& s
   return members;
 }
 
-}  // namespace
+// The steps of generate_mbs and what they share: the model and its lists, the emission options
+// (each function's name set as it is emitted), the statistics gathered into `result`, and the
+// emitted functions by the file they go to. generate_mbs calls the steps in a fixed order: the
+// functions' auxiliaries are named in the order the functions are built (see build_tangent_groups).
+struct MbsGenerator {
+  MbsGenerator(const mbs::Model& model, const mbs::ModelLists& lists, const std::string& model_path,
+               const GenerationOptions& options, MbsGeneration& result);
 
-MbsGeneration generate_mbs(const std::string& model_path, const GenerationOptions& options) {
-  const mbs::Model model = mbs::load_model(model_path);
-  const mbs::ModelLists lists = mbs::build_model_lists(model);
-  const std::string name = model.name;
-  MbsGeneration result;
-  result.scheme_assignments = lists.assignments_built;
-
-  EmitOptions emit;
-  emit.namespace_name = "dydp::generated";
-  emit.origin = model_path + (options.expand ? " (in extenso)" : " (recursive)");
-  const std::vector<ArrayId> all_seeded = mbs::tangent_arrays(lists);
-
-  auto plain = [&](const std::string& fn, const EquationList& list, bool expanded = false) {
-    emit.function_name = fn;
-    const EquationList written = expanded ? expand(list) : compact(list);
-    result.functions.push_back({fn, lists.assignments_built, expanded ? written.outputs().size() : written.size(),
-                                count_ops(written)});
-    EmittedFunction f = emit_function(written, emit);
-    measure_text(f.definition, result.functions.back());
-    return f;
-  };
+  EmittedFunction plain(const std::string& fn, const EquationList& list, bool expanded = false);
   // `with_primal`: the tangent also writes the list's own outputs; without it only the derivative
   // part is kept (the mass: M qdd itself is never read, only the columns M [B beta]).
-  auto tangent = [&](const std::string& fn, const EquationList& list, std::vector<ArrayId> arrays,
-                     bool with_primal = true) {
-    const Direction direction = seeded(list.context(), arrays);
-    EliminationStats stats;
-    // differentiated from the compact scheme, so the tangent's size follows the primal's
-    EquationList d = differentiate(compact(list), std::span<const Direction>(&direction, 1));
-    if (!with_primal) d = derivative_outputs_only(d);
-    const EquationList t = compact(eliminate(d, &stats));
-    emit.function_name = fn;
-    result.functions.push_back({fn, stats.before, t.size(), count_ops(t)});
-    result.functions.back().ops_per_direction =
-        part_ops(t, t.primal_assignments(), t.size(), t.primal_outputs(), t.outputs().size()).total();
-    EmittedFunction f = emit_tangent(t, arrays, emit);
-    measure_text(f.definition, result.functions.back());
-    return f;
-  };
+  EmittedFunction tangent(const std::string& fn, const EquationList& list, std::vector<ArrayId> arrays,
+                          bool with_primal = true);
 
-  std::filesystem::create_directories(options.out_dir);
-  if (options.expand) {
-    std::vector<EmittedFunction> fs;
-    for (const auto& j : lists.jacobians) fs.push_back(plain(j.name, *j.list, true));
-    const std::string header = name + "_expanded.hpp";
-    write_atomically(options.out_dir / header, emit_header_file(fs, emit));
-    write_atomically(options.out_dir / (name + "_expanded.cpp"), emit_source_file(fs, header, emit));
-    return result;
-  }
+  // GenerationOptions::expand: the point Jacobians in extenso, NAME_expanded.hpp and NAME_expanded.cpp.
+  void write_expanded(const GenerationOptions& options);
+  // The trig table, M, the residual and the mass matrix; the residual's tangent and velocity tangent.
+  void build_dynamics();
+  // MbsGeneration::parts.
+  void measure_parts();
+  // The constraints and their tangents.
+  void build_kinematics();
+  // The sensors, all and in two groups, with their tangents; the point Jacobians.
+  void build_sensors();
+  // NAME_residual_tangent_groups (its entry and its blocks) and each coordinate's group.
+  void build_tangent_groups(const std::vector<int>& jacobian_nonzero);
+  // NAME.hpp and every source file but the descriptor.
+  void write_sources(const GenerationOptions& options, const std::string& header) const;
 
+  const mbs::Model& model;
+  const mbs::ModelLists& lists;
+  const std::string name;
+  MbsGeneration& result;
+  EmitOptions emit;
+  std::vector<ArrayId> all_seeded;
+  const std::size_t n, m;
   // Six translation units, so that a large model's code compiles in parallel: dynamics (M and
   // the residual), its tangent, its velocity tangent, its tangent in blocks (empty for a model
   // without groups), kinematics (constraints), sensors and Jacobians.
   std::vector<EmittedFunction> dynamics, residual_tangent, kinematics, sensors;
+  std::vector<EmittedFunction> velocity_tangent;
+  std::vector<EmittedFunction> tangent_groups_tu;  // its own file: the entry of the grouped tangent
+  // its blocks' functions, kTangentBlockFiles files balanced by assignments (the sedan's blocks
+  // together are 28 000 assignments: one file of them took 6.5 minutes to compile under ASan)
+  std::vector<std::vector<EmittedFunction>> tangent_block_files =
+      std::vector<std::vector<EmittedFunction>>(kTangentBlockFiles);
+  std::vector<int> tangent_group;  // each coordinate's group in the grouped tangent, -1 for none
+  int tangent_groups = 0;
+};
+
+MbsGenerator::MbsGenerator(const mbs::Model& model, const mbs::ModelLists& lists, const std::string& model_path,
+                           const GenerationOptions& options, MbsGeneration& result)
+    : model(model), lists(lists), name(model.name), result(result), n(model.coordinates()),
+      m(model.constraint_count()), tangent_group(n, -1) {
+  emit.namespace_name = "dydp::generated";
+  emit.origin = model_path + (options.expand ? " (in extenso)" : " (recursive)");
+  all_seeded = mbs::tangent_arrays(lists);
+}
+
+EmittedFunction MbsGenerator::plain(const std::string& fn, const EquationList& list, bool expanded) {
+  emit.function_name = fn;
+  const EquationList written = expanded ? expand(list) : compact(list);
+  result.functions.push_back({fn, lists.assignments_built, expanded ? written.outputs().size() : written.size(),
+                              count_ops(written)});
+  EmittedFunction f = emit_function(written, emit);
+  measure_text(f.definition, result.functions.back());
+  return f;
+}
+
+EmittedFunction MbsGenerator::tangent(const std::string& fn, const EquationList& list, std::vector<ArrayId> arrays,
+                                      bool with_primal) {
+  const Direction direction = seeded(list.context(), arrays);
+  EliminationStats stats;
+  // differentiated from the compact scheme, so the tangent's size follows the primal's
+  EquationList d = differentiate(compact(list), std::span<const Direction>(&direction, 1));
+  if (!with_primal) d = derivative_outputs_only(d);
+  const EquationList t = compact(eliminate(d, &stats));
+  emit.function_name = fn;
+  result.functions.push_back({fn, stats.before, t.size(), count_ops(t)});
+  result.functions.back().ops_per_direction =
+      part_ops(t, t.primal_assignments(), t.size(), t.primal_outputs(), t.outputs().size()).total();
+  EmittedFunction f = emit_tangent(t, arrays, emit);
+  measure_text(f.definition, result.functions.back());
+  return f;
+}
+
+void MbsGenerator::write_expanded(const GenerationOptions& options) {
+  std::vector<EmittedFunction> fs;
+  for (const auto& j : lists.jacobians) fs.push_back(plain(j.name, *j.list, true));
+  const std::string header = name + "_expanded.hpp";
+  write_atomically(options.out_dir / header, emit_header_file(fs, emit));
+  write_atomically(options.out_dir / (name + "_expanded.cpp"), emit_source_file(fs, header, emit));
+}
+
+void MbsGenerator::build_dynamics() {
   // sin and cos of the coordinates once per state, shared by every function below
   emit.trig_table = name + "_trig";
   dynamics.push_back(emit_trig_table(static_cast<std::size_t>(model.coordinates()), emit));
@@ -255,18 +245,11 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   // or acceleration seed), every derivative through the rotations and positions is zero and
   // the scheme keeps only what the velocities reach (on the sedan 58 % of the operations per
   // direction). Its own file, so that it compiles beside the full tangent.
-  std::vector<EmittedFunction> velocity_tangent;
   velocity_tangent.push_back(
       tangent(name + "_residual_velocity_tangent", *lists.residual, {lists.qd, lists.qdd, lists.inp, lists.p}));
-  const std::size_t n = model.coordinates(), m = model.constraint_count();
-  std::vector<EmittedFunction> tangent_groups_tu;  // its own file: the entry of the grouped tangent
-  // its blocks' functions, kTangentBlockFiles files balanced by assignments (the sedan's blocks
-  // together are 28 000 assignments: one file of them took 6.5 minutes to compile under ASan)
-  std::vector<std::vector<EmittedFunction>> tangent_block_files(kTangentBlockFiles);
-  // (jacobian_nonzero: the descriptor's, and the coupling of the tangent's coordinate groups)
-  const std::vector<int> jacobian_nonzero = jacobian_structure(lists, static_cast<int>(m), static_cast<int>(n));
-  std::vector<int> tangent_group(n, -1);
-  int tangent_groups = 0;
+}
+
+void MbsGenerator::measure_parts() {
   auto part = [&](const std::string& label, const EquationList& list, std::size_t from, std::size_t to) {
     EquationList alone(list.context());
     for (const auto& a : list.assignments()) alone.append(a);
@@ -281,9 +264,15 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
     part(name + "_constraints.h_J_Jdot_qd", *lists.constraint_kinematics, 0, m + m * n + m);
     part(name + "_constraints.Jdot_qd", *lists.constraint_kinematics, m + m * n, m + m * n + m);
   }
+}
+
+void MbsGenerator::build_kinematics() {
   kinematics.push_back(plain(name + "_constraints", *lists.constraints));
   kinematics.push_back(tangent(name + "_constraints_tangent", *lists.position_constraints, all_seeded));
   kinematics.push_back(tangent(name + "_velocity_constraints_tangent", *lists.velocity_constraints, all_seeded));
+}
+
+void MbsGenerator::build_sensors() {
   sensors.push_back(plain(name + "_sensors", *lists.sensors));
   sensors.push_back(tangent(name + "_sensors_tangent", *lists.sensors, all_seeded));
   // The sensors in two groups, for a block that asks for positions and velocities before the
@@ -304,6 +293,9 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
     sensors.push_back(tangent(fn + "_tangent", reduced, all_seeded));
   }
   for (const auto& j : lists.jacobians) sensors.push_back(plain(j.name, *j.list));
+}
+
+void MbsGenerator::build_tangent_groups(const std::vector<int>& jacobian_nonzero) {
   // The residual's tangent in blocks (symbolic/grouped_tangent.hpp): a full block and a velocity
   // block (as the residual's two tangents above), then for each group of coordinates that move
   // together a position block (q, qd, qdd seeded in the group) and a velocity block (qd, qdd in
@@ -358,17 +350,13 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
         for (int c : kept[g]) tangent_group[c] = static_cast<int>(g);
     }
   }
+}
 
-  bool automatic = false;
-  const std::vector<int> independent = choose_independent(model, automatic);
-  result.independent_automatic = automatic;
-  for (int j : independent) result.independent.push_back(model.joints[j].name);
-
+void MbsGenerator::write_sources(const GenerationOptions& options, const std::string& header) const {
   std::vector<EmittedFunction> all = dynamics;
   for (const auto* part : {&residual_tangent, &velocity_tangent, &tangent_groups_tu, &kinematics, &sensors})
     all.insert(all.end(), part->begin(), part->end());
   for (const auto& file : tangent_block_files) all.insert(all.end(), file.begin(), file.end());
-  const std::string header = name + ".hpp";
   std::string header_text = emit_header_file(all, emit);
   header_text += "\n#include \"symbolic/mbs/generated_model.hpp\"\n\nnamespace dydp::generated {\nextern const dydp::mbs::GeneratedModel " +
                  name + "_model;\n}  // namespace dydp::generated\n";
@@ -382,87 +370,48 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
                      emit_source_file(tangent_block_files[file], header, emit));
   write_atomically(options.out_dir / (name + "_kinematics.cpp"), emit_source_file(kinematics, header, emit));
   write_atomically(options.out_dir / (name + "_sensors.cpp"), emit_source_file(sensors, header, emit));
+}
 
-  // The descriptor.
-  std::vector<std::string> coordinates, parameters, parameter_units;
-  std::vector<double> parameter_values, q0;
-  for (const auto& j : model.joints) {
-    coordinates.push_back(j.name);
-    q0.push_back(j.initial);
+}  // namespace
+
+MbsGeneration generate_mbs(const std::string& model_path, const GenerationOptions& options) {
+  const mbs::Model model = mbs::load_model(model_path);
+  const mbs::ModelLists lists = mbs::build_model_lists(model);
+  const std::string name = model.name;
+  MbsGeneration result;
+  result.scheme_assignments = lists.assignments_built;
+  MbsGenerator g(model, lists, model_path, options, result);
+
+  std::filesystem::create_directories(options.out_dir);
+  if (options.expand) {
+    g.write_expanded(options);
+    return result;
   }
-  for (const auto& p : model.parameters)
-    if (p.symbolic) {
-      parameters.push_back(p.name);
-      parameter_values.push_back(p.value);
-      parameter_units.push_back(p.unit);
-    }
-  const std::vector<int> driven = model.driven_joints();
-  std::string d = "// Generated by dydp-gen; do not edit.\n// Source: " + emit.origin + "\n#include \"" + header +
-                  "\"\n\nnamespace dydp::generated {\nnamespace {\n";
-  d += string_array("coordinate_names", coordinates);
-  d += string_array("input_names", model.input_names());
-  d += string_array("parameter_names", parameters);
-  d += number_array("double", "parameter_values", parameter_values);
-  d += string_array("parameter_units", parameter_units);
-  d += string_array("sensor_names", model.sensor_output_names());
-  std::vector<std::string> sensor_ports;
-  std::vector<int> sensor_widths, sensor_acc;
-  std::vector<std::string> sensor_units;
-  for (const auto& sensor : model.sensors) {
-    sensor_ports.push_back(sensor.name);
-    sensor_units.push_back(sensor_unit(model, sensor));
-    sensor_widths.push_back(sensor.width());
-    sensor_acc.push_back(reads_acceleration(sensor));
-  }
-  std::vector<std::string> load_names;
-  std::vector<int> load_widths;
-  for (const auto& load : model.loads) {
-    load_names.push_back(load.name);
-    load_widths.push_back(load.width());
-  }
-  d += string_array("load_names", load_names);
-  d += number_array("int", "load_widths", load_widths);
-  d += string_array("sensor_ports", sensor_ports);
-  d += number_array("int", "sensor_widths", sensor_widths);
-  d += number_array("int", "sensor_reads_acceleration", sensor_acc);
-  d += string_array("sensor_units", sensor_units);
-  d += number_array("double", "initial_q", q0);
-  d += number_array("int", "driven", driven);
-  d += number_array("int", "independent", independent);
-  d += number_array("int", "jacobian_nonzero", jacobian_nonzero);
-  d += number_array("int", "tangent_group", tangent_group);
-  // the mass matrix's entries: (row, col) of each output of NAME_mass_matrix, read off its names
-  std::vector<int> mass_rows, mass_cols;
-  if (lists.mass_loops) mass_loops_entries(*lists.mass_loops, mass_rows, mass_cols);
-  for (const auto& o : lists.mass_matrix ? lists.mass_matrix->outputs() : std::vector<symbolic::Output>{}) {
-    const auto comma = o.name.find(',');
-    mass_rows.push_back(std::stoi(o.name.substr(2, comma - 2)));
-    mass_cols.push_back(std::stoi(o.name.substr(comma + 1)));
-  }
-  d += number_array("int", "mass_rows", mass_rows);
-  d += number_array("int", "mass_cols", mass_cols);
-  d += "}  // namespace\n\n";
-  d += "// independent coordinates" + std::string(automatic ? " (automatic, pivoted QR of J at q0)" : "") + ":";
-  for (const auto& u : result.independent) d += " " + u;
-  d += "\nextern const dydp::mbs::GeneratedModel " + name + "_model = {\n";
-  d += "    \"" + name + "\", " + std::to_string(model.coordinates()) + ", " + std::to_string(model.constraint_count()) +
-       ", " + std::to_string(model.input_count()) + ", " + std::to_string(model.loads.size()) + ", " +
-       std::to_string(parameters.size()) + ", " + std::to_string(model.sensor_output_names().size()) + ",\n";
-  d += "    coordinate_names, input_names, parameter_names, parameter_values, sensor_names,\n";
-  d += "    " + std::to_string(sensor_ports.size()) + ", sensor_ports, sensor_widths, sensor_reads_acceleration, initial_q,\n";
-  d += "    " + std::to_string(driven.size()) + ", driven, " + std::to_string(independent.size()) + ", independent,\n";
-  d += "    " + name + "_mass, " + name + "_residual, " + name + "_residual_tangent, " + name + "_constraints,\n";
-  d += "    " + name + "_velocity_constraints_tangent, " + name + "_sensors, " + name + "_sensors_tangent,\n";
-  d += "    " + std::to_string(model.load_input_count()) + ", load_names, load_widths, sensor_units,\n";
-  d += "    jacobian_nonzero, " + name + "_constraints_tangent,\n";
-  d += "    " + std::to_string(mass_rows.size()) + ", mass_rows, mass_cols, " +
-       (lists.mass_matrix || lists.mass_loops ? name + "_mass_matrix" : std::string("nullptr")) + ",\n    parameter_units,\n";
-  d += "    " + name + "_sensors_kinematic, " + name + "_sensors_kinematic_tangent, " + name + "_sensors_acceleration, " +
-       name + "_sensors_acceleration_tangent,\n    " + name + "_residual_velocity_tangent,\n";
-  d += "    " + std::to_string(tangent_groups) + ", tangent_group, " +
-       (tangent_groups > 0 ? name + "_residual_tangent_groups" : std::string("nullptr")) + "};\n\n";
-  d += "}  // namespace dydp::generated\n";
-  write_atomically(options.out_dir / (name + "_model.cpp"), d);
+
+  g.build_dynamics();
+  // (jacobian_nonzero: the descriptor's, and the coupling of the tangent's coordinate groups)
+  const std::vector<int> jacobian_nonzero = jacobian_structure(lists, static_cast<int>(g.m), static_cast<int>(g.n));
+  g.measure_parts();
+  g.build_kinematics();
+  g.build_sensors();
+  g.build_tangent_groups(jacobian_nonzero);
+
+  bool automatic = false;
+  const std::vector<int> independent = choose_independent(model, automatic);
+  result.independent_automatic = automatic;
+  for (int j : independent) result.independent.push_back(model.joints[j].name);
+
+  const std::string header = name + ".hpp";
+  g.write_sources(options, header);
+  DescriptorChoices choices;
+  choices.origin = g.emit.origin;
+  choices.header = header;
+  choices.independent = independent;
+  choices.independent_automatic = automatic;
+  choices.jacobian_nonzero = jacobian_nonzero;
+  choices.tangent_group = g.tangent_group;
+  choices.tangent_groups = g.tangent_groups;
+  write_atomically(options.out_dir / (name + "_model.cpp"), model_descriptor(model, lists, choices));
   return result;
 }
 
