@@ -25,7 +25,7 @@ class Adjoint {
   // `known_nodes`: the context's size when the primal list was complete (every node it reads).
   Adjoint(Context& ctx, EquationList& out, std::size_t known_nodes)
       : ctx_(ctx), out_(out), active_(known_nodes, 0), stamp_(known_nodes, 0), position_(known_nodes, kNone),
-        zero_(ctx.constant(0.0).id()), one_(ctx.constant(1.0).id()) {}
+        first_root_(known_nodes, kNone), shared_(known_nodes, 0), zero_(ctx.constant(0.0).id()), one_(ctx.constant(1.0).id()) {}
 
   // --- activity: does a node depend on the differentiated arrays? ------------------------------
   void set_active(NodeId symbol, bool active) { active_.at(symbol) = active ? kActive : kInactive; }
@@ -45,6 +45,47 @@ class Adjoint {
     return active_[n] == kActive;
   }
 
+  // --- nodes shared between right-hand sides ----------------------------------------------------
+  // A node that several right-hand sides read (hash-consing shares equal subexpressions) collects
+  // its adjoint from all of them, as an auxiliary does, and is propagated once, after the first of
+  // them in list order: otherwise each reader would propagate its own share through it again.
+  // Call with every root (right-hand side, then output) in list order; `index`: the root's.
+  void find_shared(NodeId root, std::uint32_t index) {
+    if (!active(root) || is_leaf(root)) return;
+    if (pending_.size() <= index) pending_.resize(index + 1);
+    ++current_stamp_;
+    std::vector<NodeId>& stack = search_;
+    stack.assign(1, root);
+    while (!stack.empty()) {
+      const NodeId n = stack.back();
+      stack.pop_back();
+      if (first_root_[n] != kNone && first_root_[n] != index) {
+        // read by an earlier root: its operands are reached through it
+        if (!shared_[n]) pending_[first_root_[n]].push_back(n);
+        shared_[n] = 1;
+        continue;
+      }
+      if (stamp_[n] == current_stamp_) continue;
+      stamp_[n] = current_stamp_;
+      first_root_[n] = index;
+      for (NodeId c : ctx_.children(n)) {
+        if (active(c) && !is_leaf(c)) stack.push_back(c);
+      }
+    }
+  }
+
+  // Propagates the shared nodes first read by root `index`, whose adjoints are now complete;
+  // parents (larger ids) before their operands.
+  void propagate_shared(std::uint32_t index, const std::string& name) {
+    if (index >= pending_.size()) return;
+    std::vector<NodeId> nodes = std::move(pending_[index]);
+    std::sort(nodes.begin(), nodes.end(), [](NodeId a, NodeId b) { return a > b; });
+    for (NodeId n : nodes) {
+      const NodeId g = take(n);
+      if (g != zero_) walk(n, g, name);
+    }
+  }
+
   // --- the backward sweep ----------------------------------------------------------------------
   // The completed adjoint of a leaf (auxiliary, input, abbreviation): the sum of its contributions.
   NodeId take(NodeId leaf) {
@@ -55,25 +96,15 @@ class Adjoint {
     return sum;
   }
 
-  // Passes `adjoint`, the adjoint of `root`, to the leaves `root` reads. `name`: of the
-  // auxiliaries that hold intermediate adjoints.
+  // Passes `adjoint`, the adjoint of `root`, to the leaves and shared nodes `root` reads.
+  // `name`: of the auxiliaries that hold intermediate adjoints.
   void propagate(NodeId root, NodeId adjoint, const std::string& name) {
     if (adjoint == zero_ || !active(root)) return;
-    if (is_leaf(root)) {
+    if (is_leaf(root) || shared_[root]) {
       give(root, adjoint);
       return;
     }
-    order(root, true);
-    const std::vector<NodeId> nodes = order_;  // a copy: order() is not reentrant
-    node_terms_.assign(nodes.size(), {});
-    for (std::size_t k = 0; k < nodes.size(); ++k) position_[nodes[k]] = static_cast<std::uint32_t>(k);
-    node_terms_.back().push_back(adjoint);  // the root is last in post-order
-    for (std::size_t k = nodes.size(); k-- > 0;) {
-      if (node_terms_[k].empty()) continue;
-      const NodeId g = ctx_.make(Op::Add, node_terms_[k]);
-      if (g != zero_) rule(nodes[k], g, name);
-    }
-    for (NodeId n : nodes) position_[n] = kNone;
+    walk(root, adjoint, name);
   }
 
   // The abbreviations' adjoints, passed to their arguments (once every contribution is in).
@@ -89,6 +120,21 @@ class Adjoint {
   }
 
  private:
+  // Reverse accumulation over the nodes of `root` (a non-leaf) down to leaves and shared nodes.
+  void walk(NodeId root, NodeId adjoint, const std::string& name) {
+    order(root, true);
+    const std::vector<NodeId> nodes = order_;  // a copy: order() is not reentrant
+    node_terms_.assign(nodes.size(), {});
+    for (std::size_t k = 0; k < nodes.size(); ++k) position_[nodes[k]] = static_cast<std::uint32_t>(k);
+    node_terms_.back().push_back(adjoint);  // the root is last in post-order
+    for (std::size_t k = nodes.size(); k-- > 0;) {
+      if (node_terms_[k].empty()) continue;
+      const NodeId g = ctx_.make(Op::Add, node_terms_[k]);
+      if (g != zero_) rule(nodes[k], g, name);
+    }
+    for (NodeId n : nodes) position_[n] = kNone;
+  }
+
   NodeId add(NodeId a, NodeId b) { const NodeId k[2] = {a, b}; return ctx_.make(Op::Add, k); }
   NodeId sub(NodeId a, NodeId b) { return add(a, neg(b)); }
   NodeId mul(NodeId a, NodeId b) { const NodeId k[2] = {a, b}; return ctx_.make(Op::Mul, k); }
@@ -117,15 +163,16 @@ class Adjoint {
     it->second.push_back(term);
   }
 
-  // The nodes of `root` below its leaves in post-order (operands first) into order_; only the
-  // active ones when `active_only`, else only those not marked yet (not yet known inactive).
+  // The nodes of `root` above its leaves in post-order (operands first) into order_: when
+  // `active_only`, the active ones down to the shared nodes (but `root`), else those not marked
+  // yet.
   void order(NodeId root, bool active_only) {
     order_.clear();
     if (is_leaf(root)) return;
     ++current_stamp_;
     auto eligible = [&](NodeId n) {
       if (is_leaf(n) || stamp_[n] == current_stamp_) return false;
-      return active_only ? active_[n] == kActive : active_[n] == kUnknown;
+      return active_only ? active_[n] == kActive && (!shared_[n] || n == root) : active_[n] == kUnknown;
     };
     if (!eligible(root)) return;
     stamp_[root] = current_stamp_;
@@ -248,6 +295,10 @@ class Adjoint {
   std::uint32_t current_stamp_ = 0;
   std::vector<std::uint32_t> position_;  // by node: in the right-hand side being propagated
   std::vector<std::pair<NodeId, std::uint32_t>> stack_;
+  std::vector<NodeId> search_;
+  std::vector<std::uint32_t> first_root_;    // by node: the first root (in list order) reading it
+  std::vector<char> shared_;                 // by node: read by more than one root
+  std::vector<std::vector<NodeId>> pending_; // by root: the shared nodes it reads first
   std::vector<NodeId> order_;
   std::vector<std::vector<NodeId>> node_terms_;  // contributions to the nodes being propagated
   std::unordered_map<NodeId, std::vector<NodeId>> terms_;  // contributions to leaves
@@ -271,19 +322,22 @@ EquationList adjoint_list(const EquationList& list, std::span<const ArrayId> arr
   }
   for (const Assignment& a : primal.assignments()) adj.set_active(a.target, adj.mark(a.value));
   for (const Output& o : primal.outputs()) adj.mark(o.value);
-
+  const auto& assignments = primal.assignments();
   const auto& outputs = primal.outputs();
+  const auto outputs_root = static_cast<std::uint32_t>(assignments.size());  // the outputs are one root
+  for (std::uint32_t i = 0; i < assignments.size(); ++i) adj.find_shared(assignments[i].value, i);
+  for (const Output& o : outputs) adj.find_shared(o.value, outputs_root);
+
   for (std::size_t j = 0; j < outputs.size(); ++j) {
     adj.propagate(outputs[j].value, ctx.array(weights).elements[j], "bar_" + outputs[j].name);
   }
-  const auto& assignments = primal.assignments();
+  adj.propagate_shared(outputs_root, "bar");
   for (std::size_t i = assignments.size(); i-- > 0;) {
     const Assignment& a = assignments[i];
-    const NodeId sum = adj.take(a.target);
-    if (sum == ctx.zero().id()) continue;
     const std::string name = ctx.symbol(a.target).name + "_b";
-    const NodeId target = result.assign(name, ctx.expr(sum)).id();
-    adj.propagate(a.value, target, name);
+    const NodeId sum = adj.take(a.target);
+    if (sum != ctx.zero().id()) adj.propagate(a.value, result.assign(name, ctx.expr(sum)).id(), name);
+    adj.propagate_shared(static_cast<std::uint32_t>(i), name);
   }
   adj.propagate_abbreviations();
   for (ArrayId a : arrays) {
