@@ -1,9 +1,9 @@
-// Reverse-mode differentiation of an equation list: one forward sweep marks what depends on the
-// differentiated arrays, one backward sweep over the assignments accumulates the adjoints. Each
-// right-hand side is walked in reverse topological order of its own nodes; the adjoints of
-// auxiliaries, inputs and sin/cos abbreviations are lists of contributions summed when they are
-// complete. The pass is linear in the size of the list and its expressions (an n-ary product
-// costs n^2, as in forward mode).
+// Reverse-mode differentiation of an equation list: forward sweeps mark what depends on the
+// differentiated arrays and which expression nodes several right-hand sides share, one backward
+// sweep over the assignments accumulates the adjoints. Each right-hand side is walked in reverse
+// topological order of its own nodes; the adjoints of auxiliaries, inputs, sin/cos abbreviations
+// and shared nodes are lists of contributions, summed when they are complete. The pass is linear
+// in the size of the list and its expressions (an n-ary product costs n^2, as in forward mode).
 #include "symbolic/reverse.hpp"
 
 #include <algorithm>
@@ -25,7 +25,8 @@ class Adjoint {
   // `known_nodes`: the context's size when the primal list was complete (every node it reads).
   Adjoint(Context& ctx, EquationList& out, std::size_t known_nodes)
       : ctx_(ctx), out_(out), active_(known_nodes, 0), stamp_(known_nodes, 0), position_(known_nodes, kNone),
-        first_root_(known_nodes, kNone), shared_(known_nodes, 0), zero_(ctx.constant(0.0).id()), one_(ctx.constant(1.0).id()) {}
+        first_root_(known_nodes, kNone), shared_(known_nodes, 0), zero_(ctx.constant(0.0).id()),
+        one_(ctx.constant(1.0).id()) {}
 
   // --- activity: does a node depend on the differentiated arrays? ------------------------------
   void set_active(NodeId symbol, bool active) { active_.at(symbol) = active ? kActive : kInactive; }
@@ -324,14 +325,17 @@ EquationList adjoint_list(const EquationList& list, std::span<const ArrayId> arr
   for (const Output& o : primal.outputs()) adj.mark(o.value);
   const auto& assignments = primal.assignments();
   const auto& outputs = primal.outputs();
-  const auto outputs_root = static_cast<std::uint32_t>(assignments.size());  // the outputs are one root
-  for (std::uint32_t i = 0; i < assignments.size(); ++i) adj.find_shared(assignments[i].value, i);
-  for (const Output& o : outputs) adj.find_shared(o.value, outputs_root);
+  // the roots, in list order: the right-hand sides, then the outputs
+  const auto m = static_cast<std::uint32_t>(assignments.size());
+  for (std::uint32_t i = 0; i < m; ++i) adj.find_shared(assignments[i].value, i);
+  for (std::uint32_t j = 0; j < outputs.size(); ++j) adj.find_shared(outputs[j].value, m + j);
 
-  for (std::size_t j = 0; j < outputs.size(); ++j) {
+  for (std::uint32_t j = 0; j < outputs.size(); ++j) {
     adj.propagate(outputs[j].value, ctx.array(weights).elements[j], "bar_" + outputs[j].name);
   }
-  adj.propagate_shared(outputs_root, "bar");
+  for (std::uint32_t j = static_cast<std::uint32_t>(outputs.size()); j-- > 0;) {
+    adj.propagate_shared(m + j, "bar_" + outputs[j].name);
+  }
   for (std::size_t i = assignments.size(); i-- > 0;) {
     const Assignment& a = assignments[i];
     const std::string name = ctx.symbol(a.target).name + "_b";

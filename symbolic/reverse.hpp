@@ -16,7 +16,8 @@ namespace dydp::symbolic {
 // weight_array(list.outputs().size()). Outputs: the outputs of `list`, then w^T d(outputs)/dx
 // for every element x of `arrays`, in array order, named `bar(x)`. Within each right-hand side,
 // the adjoints of its expression nodes are accumulated in reverse topological order; those that
-// feed more than one operand are auxiliaries of their own (`A_b_1`, ...). Branches follow
+// feed more than one operand are auxiliaries of their own (`A_b_1`, ...). A node shared by several
+// right-hand sides is propagated once, with the sum of their contributions. Branches follow
 // differentiate.hpp (min, max and select pass the adjoint to the operand chosen; sign passes
 // none). Eliminated.
 EquationList adjoint_list(const EquationList& list, std::span<const ArrayId> arrays);

@@ -1,7 +1,8 @@
 // Reverse mode against forward mode and closed forms: the dot-product identity <w, J v> = <J^T w, v>
 // between tangent_list and adjoint_list on random lists, J^T w entry by entry against complex
 // steps, every node kind's adjoint against its closed-form gradient (both branches of the
-// non-smooth ones), and zero adjoints never assigned.
+// non-smooth ones), zero adjoints never assigned, nodes shared between right-hand sides propagated
+// once, and the operation counts against the primal's and the tangent's.
 #include "symbolic/reverse.hpp"
 
 #include <gtest/gtest.h>
@@ -241,6 +242,26 @@ TEST(Reverse, ZeroAdjointsVanish) {
   const EquationList e = adjoint_list(list, std::span<const ArrayId>(&q, 1));
   EXPECT_EQ(e.size() - e.primal_assignments(), 1u);
   EXPECT_EQ(ctx.symbol(e.assignments().back().target).name, "A_b");
+}
+
+TEST(Reverse, ANodeSharedByTwoRightHandSidesIsPropagatedOnce) {
+  Context ctx;
+  const ArrayId q = ctx.add_array("q", 3, SymbolKind::Input);
+  EquationList list(ctx);
+  const Expr q1 = ctx.element(q, 0), q2 = ctx.element(q, 1), q3 = ctx.element(q, 2);
+  const Expr n = q1 * q2 * q3;  // one node, read by both
+  list.add_output("a", list.assign("A", sin(n)));
+  list.add_output("b", list.assign("B", exp(n) + q1));
+  const EquationList adjoint = adjoint_list(list, std::span<const ArrayId>(&q, 1));
+  // A_b = w1 and B_b = w2 are inlined: the one adjoint assigned is n's, w1 cos(n) + w2 exp(n).
+  EXPECT_EQ(adjoint.size() - adjoint.primal_assignments(), 1u);
+  ArrayValues<double> x(ctx);
+  x.values[q] = {0.7, -1.3, 0.5};
+  x.values[ctx.weight_array(2)] = {0.3, -0.8};
+  const std::vector<double> g = testing::run(Tape(adjoint), x);
+  const double v = 0.7 * -1.3 * 0.5, dn = 0.3 * std::cos(v) - 0.8 * std::exp(v);
+  const double expected[3] = {dn * -1.3 * 0.5 - 0.8, dn * 0.7 * 0.5, dn * 0.7 * -1.3};
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(testing::close(g[2 + i], expected[i], 1e-14)) << g[2 + i];
 }
 
 TEST(Reverse, CostsAFewPrimals) {
