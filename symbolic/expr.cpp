@@ -199,7 +199,7 @@ ArrayId Context::add_array(std::string name, std::size_t size, SymbolKind kind,
 
 ArrayId Context::seed_array(ArrayId of) {
   for (ArrayId a = 0; a < arrays_.size(); ++a) {
-    if (arrays_[a].kind == SymbolKind::Seed && arrays_[a].seed_of == of) return a;
+    if (arrays_[a].kind == SymbolKind::Seed && arrays_[a].seed_of == of && a != of) return a;
   }
   names_.insert("seed_" + arrays_.at(of).name);  // the tangent function's argument
   return new_seed_array(of, unique_name("d" + arrays_.at(of).name), "");
@@ -218,6 +218,20 @@ ArrayId Context::new_seed_array(ArrayId of, std::string name, std::string_view s
 ArrayId Context::add_seed_array(ArrayId of, std::string_view suffix) {
   seed_array(of);  // the generic one first, so that seed_array never returns this one
   return new_seed_array(of, unique_name("d" + arrays_.at(of).name + "_" + std::string(suffix)), "_");
+}
+
+ArrayId Context::weight_array(std::size_t size) {
+  for (ArrayId a = 0; a < arrays_.size(); ++a) {
+    const Array& arr = arrays_[a];
+    if (arr.kind == SymbolKind::Seed && arr.seed_of == a && arr.elements.size() == size) return a;
+  }
+  const auto id = static_cast<ArrayId>(arrays_.size());
+  arrays_.push_back(Array{unique_name("wbar"), SymbolKind::Seed, {}, id});
+  for (std::size_t i = 0; i < size; ++i) {
+    arrays_[id].elements.push_back(new_symbol(unique_name(arrays_[id].name + std::to_string(i + 1)),
+                                              SymbolKind::Seed, id, static_cast<std::uint32_t>(i)));
+  }
+  return id;
 }
 
 std::optional<ArrayId> Context::find_array(std::string_view name) const {

@@ -88,6 +88,10 @@ class Context {
   // A further Seed array for `array` (named `d<name>_<suffix>`), for a tangent whose blocks
   // each read seeds of their own (symbolic/grouped_tangent.hpp); seed_array keeps the first.
   ArrayId add_seed_array(ArrayId array, std::string_view suffix);
+  // The Seed array of `size` output weights an adjoint function reads (symbolic/reverse.hpp),
+  // created on first call for that size, named `wbar` (`wbar_2`, ... for further sizes). It
+  // carries no array's directions: its seed_of is its own id, as for inputs.
+  ArrayId weight_array(std::size_t size);
   Expr element(ArrayId array, std::size_t index);
   const Array& array(ArrayId id) const { return arrays_.at(id); }
   std::size_t array_count() const { return arrays_.size(); }
