@@ -76,7 +76,7 @@ def scope():
         files[f] = (TANGENT_NAME, ENGINE_LINEAR)
     files["symbolic/differentiate.cpp"] = (None, SYMBOLIC)
     files["symbolic/grouped_tangent.cpp"] = (None, SYMBOLIC)
-    files["symbolic/emit_cpp.cpp"] = (TANGENT_NAME, SYMBOLIC)
+    files["symbolic/emit_cpp_tangent.cpp"] = (TANGENT_NAME, SYMBOLIC)
     return files
 
 

@@ -4,7 +4,7 @@
 # Applies single-token mutations (a sign flipped, a term times 2, a subscript off by one, a term
 # dropped) to the functions that compute tangents, Jacobians and derivatives in blocks/, engine/
 # and the generator (symbolic/differentiate.cpp, grouped_tangent.cpp, the tangent emission of
-# emit_cpp.cpp), one mutant at a time: the file edited, the test executables that cover it rebuilt
+# emit_cpp_tangent.cpp), one mutant at a time: the file edited, the test executables that cover it rebuilt
 # in the release build (ninja, only what changed), run with a time limit (120 s an executable),
 # the mutant recorded killed, survived or stillborn (does not compile), the file restored. The
 # sample is drawn with the seed from all the mutants (scripts/mutate.py --list prints it).

@@ -121,7 +121,9 @@ std::string stats_json(const std::vector<FunctionStats>& functions, double secon
       const FunctionStats& f = parts[i];
       s << (i ? ",\n" : "\n") << "    \"" << f.name << "\": {\"equations\": " << f.equations_after
         << ", \"ops\": {\"add\": " << f.ops.add << ", \"mul\": " << f.ops.mul << ", \"div\": " << f.ops.div
-        << ", \"call\": " << f.ops.call << "}, \"ops_total\": " << f.ops.total() << "}";
+        << ", \"call\": " << f.ops.call << "}, \"ops_total\": " << f.ops.total();
+      if (f.ops_per_direction) s << ", \"ops_per_direction\": " << f.ops_per_direction;
+      s << "}";
     }
     s << "\n  },\n";
   }

@@ -16,6 +16,7 @@
 #include "symbolic/mbs/model.hpp"
 #include "symbolic/mbs/newton_euler.hpp"
 #include "symbolic/mbs/numeric_dynamics.hpp"
+#include "symbolic/reverse.hpp"
 
 namespace dydp::gen {
 namespace {
@@ -154,6 +155,10 @@ struct MbsGenerator {
   void build_dynamics();
   // MbsGeneration::parts.
   void measure_parts();
+  // The residual's vector-Jacobian product (symbolic/reverse.hpp) measured as a part beside its
+  // tangent: one weight vector on r and the constraint accelerations, products for every seeded
+  // array. Not emitted yet; run last, so that the nodes it adds cannot touch the code written.
+  void measure_adjoint();
   // The constraints and their tangents.
   void build_kinematics();
   // The sensors, all and in two groups, with their tangents; the point Jacobians.
@@ -264,6 +269,15 @@ void MbsGenerator::measure_parts() {
     part(name + "_constraints.h_J_Jdot_qd", *lists.constraint_kinematics, 0, m + m * n + m);
     part(name + "_constraints.Jdot_qd", *lists.constraint_kinematics, m + m * n, m + m * n + m);
   }
+}
+
+void MbsGenerator::measure_adjoint() {
+  const EquationList adjoint = compact(adjoint_list(*lists.residual, all_seeded));
+  const EquationList primal = compact(eliminate(*lists.residual));
+  FunctionStats part{name + "_residual_adjoint", adjoint.size(), adjoint.size(), count_ops(adjoint)};
+  // what the reverse sweep adds to the primal: the cost of one more weight vector
+  part.ops_per_direction = part.ops.total() - std::min(part.ops.total(), count_ops(primal).total());
+  result.parts.push_back(part);
 }
 
 void MbsGenerator::build_kinematics() {
@@ -412,6 +426,7 @@ MbsGeneration generate_mbs(const std::string& model_path, const GenerationOption
   choices.tangent_group = g.tangent_group;
   choices.tangent_groups = g.tangent_groups;
   write_atomically(options.out_dir / (name + "_model.cpp"), model_descriptor(model, lists, choices));
+  g.measure_adjoint();
   return result;
 }
 
