@@ -25,7 +25,8 @@ struct ScreenArrays {
 };
 
 ScreenArrays screen(const std::filesystem::path& path, const std::vector<std::string>& parameters, int samples,
-                    const std::filesystem::path& out, const py::dict& overrides, bool resume, int threads) {
+                    const std::filesystem::path& out, const py::dict& overrides, bool resume, int threads,
+                    bool estimate, bool adjoint) {
   engine::ScreenSpec spec;
   spec.scene = path.string();
   spec.overrides = overrides_from(overrides);
@@ -34,6 +35,8 @@ ScreenArrays screen(const std::filesystem::path& path, const std::vector<std::st
   spec.out = out.string();
   spec.resume = resume;
   spec.threads = threads;
+  spec.estimate = estimate;
+  spec.adjoint = adjoint;
   engine::ScreenResult r;
   {
     py::gil_scoped_release released;
@@ -122,8 +125,11 @@ void add_screen_bindings(py::module_& m) {
       });
   m.def("screen", &screen, py::arg("scene"), py::arg("parameters"), py::arg("samples"), py::arg("out"),
         py::arg("overrides") = py::dict(), py::arg("resume") = false, py::arg("threads") = 0,
+        py::arg("estimate") = true, py::arg("adjoint") = false,
         "Screens scene parameters (or declared directions) over their ranges as dydp screen: `samples` Sobol' "
-        "points and the nominal point, each run recorded in out/runs/; resume keeps those records.");
+        "points and the nominal point, each run recorded in out/runs/; resume keeps those records. estimate: "
+        "each run estimates its own error (--no-estimate when false); adjoint: the gradients by the adjoint "
+        "method, one backward run per point whatever the number of parameters (--adjoint).");
 }
 
 }  // namespace dydp::python

@@ -41,3 +41,26 @@ def test_screen_resumes_from_its_records(tmp_path, short_msd):
     assert first.recorded_before == 0 and again.recorded_before == 5
     np.testing.assert_array_equal(again.values[:4], first.values)
     np.testing.assert_array_equal(again.gradients[:4], first.gradients)
+
+
+def test_screen_by_the_adjoint_equals_the_cli_and_the_forward_gradients(tmp_path, short_msd):
+    """screen(adjoint=True) as `dydp screen --adjoint`: the same Sobol' points and values, the
+    gradients of the adjoint runs equal to the CLI's bit for bit and to the forward sensitivities'
+    within the runs' tolerances."""
+    params = ["mass", "stiffness", "damping"]
+    dydp_cli("screen", short_msd, "--params", ",".join(params), "--samples", "4", "--adjoint", "--no-estimate",
+             "--out", tmp_path / "cli")
+    table = np.loadtxt(tmp_path / "cli" / "samples.csv", delimiter=",", skiprows=1)
+    adjoint = dydp.screen(short_msd, params, 4, str(tmp_path / "adjoint"), threads=1, estimate=False, adjoint=True)
+    forward = dydp.screen(short_msd, params, 4, str(tmp_path / "forward"), threads=1, estimate=False)
+    np.testing.assert_array_equal(table[1:, 1:4], adjoint.p)
+    np.testing.assert_array_equal(table[1:, 4], adjoint.values[:, 0])
+    cli = read_json(tmp_path / "cli" / "screen.json")
+    for i, name in enumerate(params):
+        assert adjoint.nu[0, i] == cli["objectives"]["x_rms"]["parameters"][name]["nu"]
+    np.testing.assert_array_equal(adjoint.p, forward.p)
+    np.testing.assert_allclose(adjoint.values, forward.values, rtol=1e-6)
+    scale = np.abs(forward.gradients).max(axis=0, keepdims=True)
+    assert np.all(scale > 0)
+    np.testing.assert_allclose(adjoint.gradients / scale, forward.gradients / scale, rtol=0, atol=1e-4)
+    assert not np.array_equal(adjoint.gradients, forward.gradients)  # two methods, not one run twice
