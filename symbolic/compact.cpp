@@ -9,6 +9,7 @@
 //     its line longer than max_line_ops operations is given its own auxiliary too.
 #include "symbolic/compact.hpp"
 
+#include "symbolic/dag_walk.hpp"
 #include "symbolic/op_count.hpp"
 
 #include <algorithm>
@@ -154,22 +155,14 @@ class Compactor {
   void count() {
     readers_.assign(ctx_.size(), 0);
     seeded_.assign(ctx_.size(), 0);
-    std::vector<char> seen(ctx_.size(), 0);
-    std::vector<NodeId> stack;
+    DagWalk walk(ctx_);
     auto visit = [&](NodeId root) {
       ++readers_[root];
-      stack.push_back(root);
-      while (!stack.empty()) {
-        const NodeId n = stack.back();
-        stack.pop_back();
-        if (seen[n]) continue;
-        seen[n] = 1;
-        if (is_atom(ctx_, n)) continue;
-        for (NodeId c : ctx_.children(n)) {
-          ++readers_[c];
-          if (!seen[c]) stack.push_back(c);
-        }
-      }
+      walk.walk(root, [&](NodeId n) {
+        if (is_atom(ctx_, n)) return false;
+        for (NodeId c : ctx_.children(n)) ++readers_[c];
+        return true;
+      });
     };
     for (const Assignment& a : resolved_) visit(a.value);
     for (NodeId o : resolved_outputs_) visit(o);

@@ -3,30 +3,22 @@
 // most once over the whole sweep, since the auxiliaries a node reads never change.
 #include "symbolic/eliminate.hpp"
 
+#include "symbolic/dag_walk.hpp"
+
 #include <vector>
 
 namespace dydp::symbolic {
 
 EquationList eliminate(const EquationList& list, EliminationStats* stats) {
   const Context& ctx = list.context();
-  std::vector<char> visited(ctx.size(), 0);
   std::vector<char> needed(ctx.size(), 0);
-  std::vector<NodeId> stack;
+  DagWalk walk(ctx);
   auto mark_from = [&](NodeId root) {
-    stack.push_back(root);
-    while (!stack.empty()) {
-      const NodeId n = stack.back();
-      stack.pop_back();
-      if (visited[n]) continue;
-      visited[n] = 1;
-      if (ctx.op(n) == Op::Symbol) {
-        if (ctx.symbol(n).kind == SymbolKind::Aux) needed[n] = 1;
-        continue;
-      }
-      for (NodeId c : ctx.children(n)) {
-        if (!visited[c]) stack.push_back(c);
-      }
-    }
+    walk.walk(root, [&](NodeId n) {
+      if (ctx.op(n) != Op::Symbol) return true;
+      if (ctx.symbol(n).kind == SymbolKind::Aux) needed[n] = 1;
+      return false;
+    });
   };
   for (const Output& o : list.outputs()) mark_from(o.value);
   const auto& assignments = list.assignments();

@@ -8,6 +8,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "symbolic/dag_walk.hpp"
 #include "symbolic/emit_cpp.hpp"
 
 namespace dydp::symbolic::emit_detail {
@@ -54,22 +55,9 @@ std::string one_line(std::string s);
 template <typename Visit>
 void walk_range(const EquationList& list, std::size_t first_assignment, std::size_t end_assignment,
                 std::size_t first_output, std::size_t end_output, Visit visit) {
-  const Context& ctx = list.context();
-  std::vector<char> seen(ctx.size(), 0);
-  std::vector<NodeId> stack;
-  auto walk = [&](NodeId root) {
-    stack.push_back(root);
-    while (!stack.empty()) {
-      const NodeId n = stack.back();
-      stack.pop_back();
-      if (seen[n]) continue;
-      seen[n] = 1;
-      if (!visit(n)) continue;
-      for (NodeId c : ctx.children(n)) stack.push_back(c);
-    }
-  };
-  for (std::size_t i = first_assignment; i < end_assignment; ++i) walk(list.assignments()[i].value);
-  for (std::size_t j = first_output; j < end_output; ++j) walk(list.outputs()[j].value);
+  DagWalk walk(list.context());
+  for (std::size_t i = first_assignment; i < end_assignment; ++i) walk.walk(list.assignments()[i].value, visit);
+  for (std::size_t j = first_output; j < end_output; ++j) walk.walk(list.outputs()[j].value, visit);
 }
 
 // The same from `first` to the end of the list.

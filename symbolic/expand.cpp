@@ -2,6 +2,8 @@
 // memoised per node so shared subexpressions are rebuilt once.
 #include "symbolic/expand.hpp"
 
+#include "symbolic/dag_walk.hpp"
+
 #include <stdexcept>
 #include <vector>
 
@@ -15,37 +17,17 @@ EquationList expand(const EquationList& list) {
   std::vector<NodeId> stack;
   std::vector<NodeId> kids;
 
+  // children first; a leaf (constant, symbol not assigned yet) stands for itself
   auto rebuild = [&](NodeId root) -> NodeId {
-    stack.push_back(root);
-    while (!stack.empty()) {
-      const NodeId n = stack.back();
-      if (substituted[n] != kUnset) {
-        stack.pop_back();
-        continue;
-      }
-      const Op op = ctx.op(n);
-      if (op == Op::Constant || op == Op::Symbol) {
-        substituted[n] = n;
-        stack.pop_back();
-        continue;
-      }
-      bool ready = true;
-      for (NodeId c : ctx.children(n)) {
-        if (substituted[c] == kUnset) {
-          stack.push_back(c);
-          ready = false;
-        }
-      }
-      if (!ready) continue;
-      stack.pop_back();
+    walk_post_order(ctx, root, stack, [&](NodeId n) { return substituted[n] != kUnset; }, [&](NodeId n) {
       kids.clear();
       bool same = true;
       for (NodeId c : ctx.children(n)) {
         kids.push_back(substituted[c]);
         same = same && substituted[c] == c;
       }
-      substituted[n] = same ? n : ctx.make(op, kids);
-    }
+      substituted[n] = same ? n : ctx.make(ctx.op(n), kids);
+    });
     return substituted[root];
   };
 

@@ -1,6 +1,8 @@
 // Flattening an equation list into a tape, and evaluating the tape.
 #include "symbolic/interpret.hpp"
 
+#include "symbolic/dag_walk.hpp"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -48,19 +50,12 @@ Tape::Tape(const EquationList& list) {
 
   // Post-order flattening of one expression; nodes met before reuse their slot.
   auto compile = [&](NodeId root) -> std::uint32_t {
-    stack.push_back(root);
-    while (!stack.empty()) {
-      const NodeId n = stack.back();
-      if (slot_of[n] != kNone) {
-        stack.pop_back();
-        continue;
-      }
+    walk_post_order(ctx, root, stack, [&](NodeId n) { return slot_of[n] != kNone; }, [&](NodeId n) {
       const Op op = ctx.op(n);
       if (op == Op::Constant) {
         slot_of[n] = slot_count_++;
         constants_.emplace_back(slot_of[n], ctx.value(n));
-        stack.pop_back();
-        continue;
+        return;
       }
       if (op == Op::Symbol) {
         const Symbol& s = ctx.symbol(n);
@@ -69,18 +64,8 @@ Tape::Tape(const EquationList& list) {
         }
         slot_of[n] = slot_count_++;
         instructions_.push_back(Instruction{kLoad, 0, false, slot_of[n], s.array, s.index});
-        stack.pop_back();
-        continue;
+        return;
       }
-      bool ready = true;
-      for (NodeId c : ctx.children(n)) {
-        if (slot_of[c] == kNone) {
-          stack.push_back(c);
-          ready = false;
-        }
-      }
-      if (!ready) continue;
-      stack.pop_back();
       Instruction ins{op, 0, false, slot_count_++, static_cast<std::uint32_t>(arguments_.size()),
                       static_cast<std::uint32_t>(ctx.children(n).size())};
       for (NodeId c : ctx.children(n)) arguments_.push_back(slot_of[c]);
@@ -93,7 +78,7 @@ Tape::Tape(const EquationList& list) {
       }
       slot_of[n] = ins.destination;
       instructions_.push_back(ins);
-    }
+    });
     return slot_of[root];
   };
 

@@ -3,6 +3,8 @@
 // ascending sweep over the reachable nodes computes them all.
 #include "symbolic/op_count.hpp"
 
+#include "symbolic/dag_walk.hpp"
+
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -76,29 +78,21 @@ std::uint64_t OpCount::total() const {
 
 OpCount count_ops(const EquationList& list) {
   const Context& ctx = list.context();
-  std::vector<char> reachable(ctx.size(), 0);
-  std::vector<NodeId> stack;
+  DagWalk reachable(ctx);
   std::uint64_t abbreviations = 0;
   auto mark = [&](NodeId root) {
-    stack.push_back(root);
-    while (!stack.empty()) {
-      const NodeId n = stack.back();
-      stack.pop_back();
-      if (reachable[n]) continue;
-      reachable[n] = 1;
-      if (ctx.is_abbreviation(n)) {
-        ++abbreviations;
-        continue;
-      }
-      for (NodeId c : ctx.children(n)) stack.push_back(c);
-    }
+    reachable.walk(root, [&](NodeId n) {
+      if (!ctx.is_abbreviation(n)) return true;
+      ++abbreviations;
+      return false;
+    });
   };
   for (const Assignment& a : list.assignments()) mark(a.value);
   for (const Output& o : list.outputs()) mark(o.value);
 
   std::vector<OpCount> tree(ctx.size());
   for (NodeId n = 0; n < ctx.size(); ++n) {
-    if (!reachable[n] || ctx.is_abbreviation(n)) continue;
+    if (!reachable.seen(n) || ctx.is_abbreviation(n)) continue;
     OpCount c = own_ops(ctx, n);
     for (NodeId k : ctx.children(n)) c += tree[k];
     // A standalone inverse power is written 1.0/(x*...), one division; inside a product it goes

@@ -6,6 +6,8 @@
 // in the size of the list and its expressions (an n-ary product costs n^2, as in forward mode).
 #include "symbolic/reverse.hpp"
 
+#include "symbolic/dag_walk.hpp"
+
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -25,7 +27,7 @@ class Adjoint {
   // `known_nodes`: the context's size when the primal list was complete (every node it reads).
   Adjoint(Context& ctx, EquationList& out, std::size_t known_nodes)
       : ctx_(ctx), out_(out), active_(known_nodes, 0), stamp_(known_nodes, 0), position_(known_nodes, kNone),
-        first_root_(known_nodes, kNone), shared_(known_nodes, 0), zero_(ctx.constant(0.0).id()),
+        search_(ctx), first_root_(known_nodes, kNone), shared_(known_nodes, 0), zero_(ctx.constant(0.0).id()),
         one_(ctx.constant(1.0).id()) {}
 
   // --- activity: does a node depend on the differentiated arrays? ------------------------------
@@ -54,25 +56,18 @@ class Adjoint {
   void find_shared(NodeId root, std::uint32_t index) {
     if (!active(root) || is_leaf(root)) return;
     if (pending_.size() <= index) pending_.resize(index + 1);
-    ++current_stamp_;
-    std::vector<NodeId>& stack = search_;
-    stack.assign(1, root);
-    while (!stack.empty()) {
-      const NodeId n = stack.back();
-      stack.pop_back();
+    search_.restart();
+    search_.walk(root, [&](NodeId n) {
+      if (!active(n) || is_leaf(n)) return false;
       if (first_root_[n] != kNone && first_root_[n] != index) {
         // read by an earlier root: its operands are reached through it
         if (!shared_[n]) pending_[first_root_[n]].push_back(n);
         shared_[n] = 1;
-        continue;
+        return false;
       }
-      if (stamp_[n] == current_stamp_) continue;
-      stamp_[n] = current_stamp_;
       first_root_[n] = index;
-      for (NodeId c : ctx_.children(n)) {
-        if (active(c) && !is_leaf(c)) stack.push_back(c);
-      }
-    }
+      return true;
+    });
   }
 
   // Propagates the shared nodes first read by root `index`, whose adjoints are now complete;
@@ -296,7 +291,7 @@ class Adjoint {
   std::uint32_t current_stamp_ = 0;
   std::vector<std::uint32_t> position_;  // by node: in the right-hand side being propagated
   std::vector<std::pair<NodeId, std::uint32_t>> stack_;
-  std::vector<NodeId> search_;
+  DagWalk search_;                       // find_shared()'s, restarted for each root
   std::vector<std::uint32_t> first_root_;    // by node: the first root (in list order) reading it
   std::vector<char> shared_;                 // by node: read by more than one root
   std::vector<std::vector<NodeId>> pending_; // by root: the shared nodes it reads first

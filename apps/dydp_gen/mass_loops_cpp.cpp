@@ -3,8 +3,8 @@
 
 #include <algorithm>
 #include <unordered_map>
-#include <unordered_set>
 
+#include "symbolic/dag_walk.hpp"
 #include "symbolic/op_count.hpp"
 
 namespace dydp::gen {
@@ -75,6 +75,7 @@ std::vector<EmittedFunction> emit_mass_loops(const mbs::MassLoops& loops, const 
   for (std::size_t r = 0; r < loops.reads.size(); ++r) read_index[loops.reads[r]] = r;
   std::string calls;
   std::size_t at = n;  // the next entry
+  DagWalk walk(ctx);
   for (std::size_t k = 0; k < loops.sweeps.size(); ++k) {
     const auto& sweep = loops.sweeps[k];
     const std::string b = std::to_string(sweep.begin), e = std::to_string(sweep.end);
@@ -84,21 +85,16 @@ std::vector<EmittedFunction> emit_mass_loops(const mbs::MassLoops& loops, const 
             joints[sweep.parent] + "'s frame: M(., " + joints[sweep.parent] + ")\n";
     body += "static void " + sweep_name + "(double* start, double* out) noexcept\n{\n";
     // the values this loop reads besides its lanes
-    std::vector<NodeId> pending(sweep.moved.begin(), sweep.moved.end());
-    pending.push_back(sweep.entry);
     std::vector<std::size_t> used;
-    std::unordered_set<NodeId> seen;
-    while (!pending.empty()) {
-      const NodeId x = pending.back();
-      pending.pop_back();
-      if (!seen.insert(x).second) continue;
-      if (const auto it = read_index.find(x); it != read_index.end()) {
-        used.push_back(it->second);
-        continue;
-      }
-      const auto c = ctx.children(x);
-      pending.insert(pending.end(), c.begin(), c.end());
-    }
+    auto read = [&](NodeId x) {
+      const auto it = read_index.find(x);
+      if (it == read_index.end()) return true;
+      used.push_back(it->second);
+      return false;
+    };
+    walk.restart();
+    for (NodeId m : sweep.moved) walk.walk(m, read);
+    walk.walk(sweep.entry, read);
     std::sort(used.begin(), used.end());
     for (std::size_t r : used)
       body += "  const double " + to_cpp(ctx, loops.reads[r]) + " = start[" + std::to_string(7 * n + r) + "];\n";

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "symbolic/dag_walk.hpp"
 #include "symbolic/eliminate.hpp"
 
 namespace dydp::mbs::detail {
@@ -191,26 +192,20 @@ std::unique_ptr<MassLoops> Generator::mass_loops() {
 
   // What the sweeps read besides the placeholders and the function's arrays: auxiliaries
   // (an arbitrary axis's rotation, an offset along a prismatic joint) and sin/cos.
-  std::vector<char> placeholder(ctx_->size(), 0), seen(ctx_->size(), 0);
+  // Listed in the order met, the sweeps' roots walked last first (a sweep's entry before its moved).
+  std::vector<char> placeholder(ctx_->size(), 0);
   for (int a = 0; a < 6; ++a) placeholder[loops->lane[a]] = placeholder[loops->moved_lane[a]] = 1;
-  std::vector<NodeId> pending;
-  for (const MassLoops::Sweep& sweep : loops->sweeps) {
-    pending.insert(pending.end(), sweep.moved.begin(), sweep.moved.end());
-    pending.push_back(sweep.entry);
-  }
-  while (!pending.empty()) {
-    const NodeId x = pending.back();
-    pending.pop_back();
-    if (seen[x]) continue;
-    seen[x] = 1;
-    if (placeholder[x]) continue;
-    if (ctx_->is_abbreviation(x) || ctx_->is_symbol(x, SymbolKind::Aux)) {
-      loops->reads.push_back(x);
-      o.push_back({"read " + std::to_string(loops->reads.size() - 1), x});
-      continue;
-    }
-    const auto c = ctx_->children(x);
-    pending.insert(pending.end(), c.begin(), c.end());
+  symbolic::DagWalk walk(*ctx_);
+  auto read = [&](NodeId x) {
+    if (placeholder[x]) return false;
+    if (!ctx_->is_abbreviation(x) && !ctx_->is_symbol(x, SymbolKind::Aux)) return true;
+    loops->reads.push_back(x);
+    o.push_back({"read " + std::to_string(loops->reads.size() - 1), x});
+    return false;
+  };
+  for (auto sweep = loops->sweeps.rbegin(); sweep != loops->sweeps.rend(); ++sweep) {
+    walk.walk(sweep->entry, read);
+    for (auto m = sweep->moved.rbegin(); m != sweep->moved.rend(); ++m) walk.walk(*m, read);
   }
   loops->start = std::make_unique<EquationList>(symbolic::eliminate(with_outputs(*all_, std::move(o))));
   return loops;
