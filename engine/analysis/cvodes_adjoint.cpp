@@ -141,6 +141,306 @@ struct Context {
   }
 };
 
+/// One adjoint run: the forward problem, its chunks and the backward problem the steps share.
+class AdjointRun {
+ public:
+  AdjointRun(const Diagram& d, const RunOptions& options)
+      : d_(d), options_(options), bdf_(d.solver.method == "bdf"), nx_(d.num_states), nq_(d.num_quadratures),
+        ns_(static_cast<int>(d.sensitivities.size())), nm_(static_cast<int>(d.objectives.size())),
+        n_cv_(std::max(nx_ + nq_, 1)), t0_(d.time.start), tf_(d.time.stop), ev_(d, true),
+        recorder_(d, 0, result_, options), P_(d, ev_, nx_, 0), timeline_(d), B_(P_) {}
+
+  RunResult run() {
+    set_up_states();
+    first_pass();
+    finish_forward();
+    if (nm_ > 0 && ns_ > 0) backward_pass();
+    struct rusage usage {};
+    if (getrusage(RUSAGE_SELF, &usage) == 0)
+      result_.stats.adjoint.peak_rss_bytes = 1024.0 * static_cast<double>(usage.ru_maxrss);
+
+    finish_cvodes_stats(result_.stats, d_, clock_.seconds());
+    return std::move(result_);
+  }
+
+ private:
+  void check(int flag, const char* call, double t) const { check_call(P_, flag, call, t); }
+
+  // The initial state [x(t0); 0], its tolerances, the segments between breakpoints, the adjoint's
+  // statistics so far and the outputs at t0.
+  void set_up_states() {
+    check(SUNContext_Create(nullptr, &C_.ctx), "SUNContext_Create", t0_);
+    y_ = OwnedVector(N_VNew_Serial(n_cv_, C_.ctx));
+    N_VEnableFusedOps_Serial(y_.v, SUNTRUE);
+    use_compiled_vector_kernels(y_.v);
+    N_VConst(0.0, y_.v);
+    ev_.set_segment_start(t0_);
+    ev_.initial_state(t0_, NV_DATA_S(y_.v));
+    x0_.assign(NV_DATA_S(y_.v), NV_DATA_S(y_.v) + nx_);
+
+    atols_ = absolute_tolerances(d_, d_.solver.atol, 0);
+    atol_states_ = OwnedVector(state_tolerances(P_, atols_, d_.solver.atol, y_.v));
+
+    bounds_ = {t0_};
+    for (double b : timeline_.breaks)
+      if (b < tf_) bounds_.push_back(b);
+    bounds_.push_back(tf_);
+
+    AdjointStats& as = result_.stats.adjoint;
+    as.used = true;
+    as.objectives = nm_;
+    as.steps_between_checkpoints = options_.steps_between_checkpoints;
+    as.segments = static_cast<int>(bounds_.size()) - 1;
+    record(t0_);
+  }
+
+  // The outputs at t (y_ holds the state there).
+  void record(double t) {
+    ev_.outputs(t, NV_DATA_S(y_.v));
+    recorder_.record(t, NV_DATA_S(y_.v), ev_);
+  }
+
+  // A fresh forward problem from (start, y) with the run's settings, stopping at the segment's end.
+  void open_forward(Solver& S, const Chunk& c) {
+    ev_.set_segment_start(c.segment_start);
+    S.mem = CVodeCreate(bdf_ ? CV_BDF : CV_ADAMS, C_.ctx);
+    if (!S.mem) throw SolverError(c.start, "", "CVodeCreate failed");
+    set_up_forward(P_, S.mem, C_.ctx, c.start, y_.v, atol_states_.v, S.forward);
+    check(CVodeSetStopTime(S.mem, c.segment_stop), "CVodeSetStopTime", c.start);
+  }
+
+  // CVODES' counters of one forward problem added to the run's statistics.
+  void add_forward_stats(void* mem) {
+    RunStats& st = result_.stats;
+    long v = 0;
+    CVodeGetNumSteps(mem, &v), st.steps += v;
+    CVodeGetNumRhsEvals(mem, &v), st.rhs_evals += v;
+    CVodeGetNumErrTestFails(mem, &v), st.error_test_failures += v;
+    CVodeGetNumNonlinSolvIters(mem, &v), st.nonlinear_iterations += v;
+    CVodeGetNumNonlinSolvConvFails(mem, &v), st.nonlinear_failures += v;
+    if (bdf_) CVodeGetNumJacEvals(mem, &v), st.jac_evals += v;
+  }
+
+  // The forward run over every segment, cut into chunks, and its statistics.
+  void first_pass() {
+    const bool backward = nm_ > 0 && ns_ > 0;
+    const long chunk_steps = std::max(options_.steps_between_checkpoints, 1);
+
+    // the first pass: the outputs, and a checkpoint every chunk_steps steps (at an output time)
+    size_t next_event = 0;
+    for (size_t k = 0; k + 1 < bounds_.size(); ++k) {
+      Chunk c;
+      c.segment_start = c.start = bounds_[k];
+      c.segment_stop = bounds_[k + 1];
+      c.y0.assign(NV_DATA_S(y_.v), NV_DATA_S(y_.v) + n_cv_);
+      auto S = std::make_unique<Solver>();
+      open_forward(*S, c);
+      while (next_event < timeline_.events.size() && timeline_.events[next_event] <= c.segment_stop) {
+        const double target = timeline_.events[next_event++];
+        double reached = c.start;
+        check(CVode(S->mem, target, y_.v, &reached, CV_NORMAL), "CVode", reached);
+        c.targets.push_back(target);
+        if (timeline_.is_output(target)) record(target);
+        long steps = 0;
+        CVodeGetNumSteps(S->mem, &steps);
+        if (backward && steps >= chunk_steps && target < c.segment_stop) {
+          c.steps = steps;
+          add_forward_stats(S->mem);
+          chunks_.push_back(c);
+          c.start = target;
+          c.targets.clear();
+          c.y0.assign(NV_DATA_S(y_.v), NV_DATA_S(y_.v) + n_cv_);
+          S = std::make_unique<Solver>();
+          open_forward(*S, c);
+        }
+      }
+      CVodeGetNumSteps(S->mem, &c.steps);
+      add_forward_stats(S->mem);
+      if (!c.targets.empty()) chunks_.push_back(std::move(c));
+    }
+    RunStats& st = result_.stats;
+    st.adjoint.checkpoints = static_cast<long>(chunks_.size());
+    st.adjoint.forward_steps = st.steps;
+    st.local_jac_evals = P_.local_refreshes;
+    st.jacobian_colours = P_.colouring.colours();
+    st.adjoint.forward_cpu_seconds = clock_.seconds();
+  }
+
+  // The objectives' values at the end, the final state and the (zero) gradients' layout.
+  void finish_forward() {
+    // the objectives' values and dG/dq at the end
+    q_.assign(std::max(nq_, 1), 0.0);
+    std::copy_n(NV_DATA_S(y_.v) + nx_, nq_, q_.data());
+    recorder_.finish(q_.data(), {});
+    result_.final_state.assign(NV_DATA_S(y_.v), NV_DATA_S(y_.v) + nx_);
+    for (int dir = 0; dir < ns_; ++dir)
+      result_.sensitivity_names.push_back(d_.parameters[d_.sensitivities[dir]].name);
+    result_.signal_sensitivities = false;
+    for (auto& o : result_.objectives) o.sensitivity.assign(ns_, 0.0);
+  }
+
+  // The objectives' dG/dq and the backward problem's vectors with their tolerances.
+  void set_up_backward() {
+    B_.nm = nm_, B_.ns = ns_;
+    B_.g.assign(static_cast<size_t>(std::max(nq_, 1)) * nm_, 0.0);
+    ObjectiveSamples samples;
+    samples.t_start = t0_, samples.t_stop = tf_;
+    std::vector<double> scale(nm_, 1.0);  // each objective's magnitude, for the tolerances
+    for (int m = 0; m < nm_; ++m) {
+      const Node& n = d_.nodes[d_.objectives[m]];
+      const int nqn = n.block->num_quadratures();
+      if (nqn > 0 && !n.objective->quadrature_gradient(n.p.data(), q_.data() + n.quad_offset, nqn, samples,
+                                                       B_.g.data() + static_cast<size_t>(m) * nq_ + n.quad_offset))
+        throw InputError(n.file.empty() ? d_.file : n.file, n.line, n.name, "objective " + n.name + " has no adjoint");
+      const double psi = std::fabs(result_.objectives[m].value);
+      if (psi > 0 && std::isfinite(psi)) scale[m] = psi;
+    }
+    nb_ = nx_ * nm_;
+    // tolerances: the gradient ~ psi / |p| (the forward run's pbar); lambda_i is the change of psi
+    // for a unit change of state i at time t, lambda_i ~ psi / nominal_i at most. Most states
+    // (pressures, wheel hop) move psi by a small fraction of it for a nominal-sized change, so
+    // lambda's atol is 1/100 of that bound: on the quarter car at rtol = atol = 1e-9 the
+    // gradients are 7e-6 off the converged ones with the bound itself, 8e-7 with 1/10 and 2e-7
+    // with 1/100 (for 50 % more backward time; docs/engine.md, Adjoint).
+    constexpr double kLambdaAtolFraction = 0.01;
+    const std::vector<double> nominal = state_nominals(d_);
+    lambda_ = OwnedVector(N_VNew_Serial(std::max(nb_, 1), C_.ctx));
+    atol_b_ = OwnedVector(N_VNew_Serial(std::max(nb_, 1), C_.ctx));
+    grad_ = OwnedVector(N_VNew_Serial(ns_ * nm_, C_.ctx));
+    atol_q_ = OwnedVector(N_VNew_Serial(ns_ * nm_, C_.ctx));
+    N_VConst(0.0, lambda_.v);
+    N_VConst(d_.solver.atol, atol_b_.v);
+    for (int m = 0; m < nm_; ++m) {
+      for (int i = 0; i < nx_; ++i)
+        NV_Ith_S(atol_b_.v, m * nx_ + i) =
+            kLambdaAtolFraction * d_.solver.atol * scale[m] / (d_.solver.nominal_scaling ? nominal[i] : 1.0);
+      for (int dir = 0; dir < ns_; ++dir) {
+        const double p = std::fabs(d_.parameters[d_.sensitivities[dir]].value);
+        NV_Ith_S(atol_q_.v, m * ns_ + dir) = d_.solver.atol * scale[m] / (p > 0 ? p : 1.0);
+      }
+    }
+    gradient_.assign(static_cast<size_t>(ns_) * nm_, 0.0);
+    qB_ = OwnedVector(N_VNew_Serial(ns_ * nm_, C_.ctx));
+  }
+
+  // The gradients: lambda back over the chunks, last first, then the initial state's term.
+  void backward_pass() {
+    set_up_backward();
+    AdjointStats& as = result_.stats.adjoint;
+    const CpuClock backward_clock;
+    for (size_t k = chunks_.size(); k-- > 0;) {
+      const Chunk& c = chunks_[k];
+      Solver S;
+      replay(S, c);
+      integrate_back(S, c);
+    }
+    add_initial_state_term();
+    as.backward_rhs_evals = B_.rhs_passes;
+    as.backward_quadrature_evals = B_.quadrature_passes;
+    as.backward_jac_evals = B_.jac_passes;
+    as.backward_cpu_seconds = backward_clock.seconds();
+    // held: each checkpoint's state, and for the chunk being worked on y and y' at each of its
+    // steps (Hermite), in room for the most steps of a chunk
+    as.checkpoint_bytes = 8.0 * n_cv_ * (static_cast<double>(as.checkpoints) + 2.0 * (most_steps_ + 1));
+  }
+
+  // Replays chunk c on S (CVodeF) for the backward run and counts the replay's steps.
+  void replay(Solver& S, const Chunk& c) {
+    AdjointStats& as = result_.stats.adjoint;
+    // the chunk's forward run again from its checkpoint, every step stored
+    std::copy(c.y0.begin(), c.y0.end(), NV_DATA_S(y_.v));
+    open_forward(S, c);
+    void* mem = S.mem;
+    const long room = c.steps + std::max(16L, c.steps / 4);
+    most_steps_ = std::max(most_steps_, room);
+    check(CVodeAdjInit(mem, room, CV_HERMITE), "CVodeAdjInit", c.start);
+    double reached = c.start;
+    for (double target : c.targets) {
+      int ncheck = 0;
+      check(CVodeF(mem, target, y_.v, &reached, CV_NORMAL, &ncheck), "CVodeF", reached);
+    }
+    long replayed = 0;
+    CVodeGetNumSteps(mem, &replayed);
+    as.replay_steps += replayed;
+    if (replayed != c.steps) ++as.replays_differing;
+  }
+
+  // lambda and the gradient's quadrature integrated back over the chunk replayed on S.
+  void integrate_back(Solver& S, const Chunk& c) {
+    void* mem = S.mem;
+    // lambda back over the chunk
+    const double te = c.targets.back();
+    int which = 0;
+    check(CVodeCreateB(mem, bdf_ ? CV_BDF : CV_ADAMS, &which), "CVodeCreateB", te);
+    check(CVodeInitB(mem, which, backward_rhs, te, lambda_.v), "CVodeInitB", te);
+    check(CVodeSetUserDataB(mem, which, &B_), "CVodeSetUserDataB", te);
+    check(CVodeSVtolerancesB(mem, which, d_.solver.rtol, atol_b_.v), "CVodeSVtolerancesB", te);
+    check(CVodeSetMaxNumStepsB(mem, which, d_.solver.max_steps), "CVodeSetMaxNumStepsB", te);
+    if (d_.solver.max_order > 0) check(CVodeSetMaxOrdB(mem, which, d_.solver.max_order), "CVodeSetMaxOrdB", te);
+    if (bdf_) {
+      S.AB = SUNDenseMatrix(std::max(nb_, 1), std::max(nb_, 1), C_.ctx);
+      S.LSB = SUNLinSol_Dense(lambda_.v, S.AB, C_.ctx);
+      check(CVodeSetLinearSolverB(mem, which, S.LSB, S.AB), "CVodeSetLinearSolverB", te);
+      check(CVodeSetJacFnB(mem, which, backward_jacobian), "CVodeSetJacFnB", te);
+    } else {
+      S.NLSB = SUNNonlinSol_FixedPoint(lambda_.v, 0, C_.ctx);
+      check(CVodeSetNonlinearSolverB(mem, which, S.NLSB), "CVodeSetNonlinearSolverB", te);
+    }
+    N_VConst(0.0, qB_.v);
+    check(CVodeQuadInitB(mem, which, backward_quadrature, qB_.v), "CVodeQuadInitB", te);
+    check(CVodeQuadSVtolerancesB(mem, which, d_.solver.rtol, atol_q_.v), "CVodeQuadSVtolerancesB", te);
+    check(CVodeSetQuadErrConB(mem, which, SUNTRUE), "CVodeSetQuadErrConB", te);
+    check(CVodeB(mem, c.start, CV_NORMAL), "CVodeB", te);
+    double tret = 0.0;
+    check(CVodeGetB(mem, which, &tret, lambda_.v), "CVodeGetB", c.start);
+    check(CVodeGetQuadB(mem, which, &tret, qB_.v), "CVodeGetQuadB", c.start);
+    for (int i = 0; i < ns_ * nm_; ++i) gradient_[i] += NV_Ith_S(qB_.v, i);
+    void* memB = CVodeGetAdjCVodeBmem(mem, which);
+    long v = 0;
+    CVodeGetNumSteps(memB, &v), result_.stats.adjoint.backward_steps += v;
+  }
+
+  // The term lambda(t0)^T dx0/dp added, and the gradients checked and stored in the objectives.
+  void add_initial_state_term() {
+    // lambda(t0)^T dx0/dp
+    ev_.set_segment_start(t0_);
+    ev_.initial_state_adjoint(t0_, x0_.data(), nm_, {NV_DATA_S(lambda_.v), nx_}, {gradient_.data(), ns_});
+    for (int m = 0; m < nm_; ++m)
+      for (int dir = 0; dir < ns_; ++dir) {
+        const double g = gradient_[static_cast<size_t>(m) * ns_ + dir];
+        if (!std::isfinite(g))
+          throw SolverError(t0_, result_.objectives[m].name, "the adjoint gradient is not finite (direction " +
+                                                                 d_.parameters[d_.sensitivities[dir]].name + ")");
+        result_.objectives[m].sensitivity[dir] = g;
+      }
+  }
+
+  const Diagram& d_;
+  const RunOptions& options_;
+  const bool bdf_;
+  const int nx_, nq_, ns_, nm_, n_cv_;
+  const double t0_, tf_;
+  const CpuClock clock_;
+  Evaluator ev_;
+  RunResult result_;
+  Recorder recorder_;
+  Problem P_;
+  Context C_;
+  OwnedVector y_;
+  std::vector<double> x0_;
+  AbsoluteTolerances atols_;
+  OwnedVector atol_states_;
+  const Timeline timeline_;
+  std::vector<double> bounds_;  // t0, the breakpoints before tf, tf
+  std::vector<Chunk> chunks_;
+  std::vector<double> q_;       // the objective integrals at the end
+  Backward B_;
+  int nb_ = 0;                  // lambda's entries: nx per objective
+  OwnedVector lambda_, atol_b_, grad_, atol_q_, qB_;
+  std::vector<double> gradient_;  // d(psi_m)/dp: ns x nm
+  long most_steps_ = 0;           // the most steps stored for a chunk
+};
+
 }  // namespace
 
 void check_adjoint_possible(const Diagram& d) {
@@ -160,234 +460,7 @@ void check_adjoint_possible(const Diagram& d) {
 
 RunResult run_cvodes_adjoint(const Diagram& d, const RunOptions& options) {
   check_adjoint_possible(d);
-  const bool bdf = d.solver.method == "bdf";
-  const int nx = d.num_states, nq = d.num_quadratures;
-  const int ns = static_cast<int>(d.sensitivities.size());
-  const int nm = static_cast<int>(d.objectives.size());
-  const int n_cv = std::max(nx + nq, 1);
-  const double t0 = d.time.start, tf = d.time.stop;
-  const CpuClock clock;
-
-  Evaluator ev(d, true);
-  RunResult result;
-  Recorder recorder(d, 0, result, options);
-  Problem P(d, ev, nx, 0);
-  Context C;
-  auto check = [&](int flag, const char* call, double t) { check_call(P, flag, call, t); };
-  check(SUNContext_Create(nullptr, &C.ctx), "SUNContext_Create", t0);
-  OwnedVector y(N_VNew_Serial(n_cv, C.ctx));
-  N_VEnableFusedOps_Serial(y.v, SUNTRUE);
-  use_compiled_vector_kernels(y.v);
-  N_VConst(0.0, y.v);
-  ev.set_segment_start(t0);
-  ev.initial_state(t0, NV_DATA_S(y.v));
-  const std::vector<double> x0(NV_DATA_S(y.v), NV_DATA_S(y.v) + nx);
-
-  const AbsoluteTolerances atols = absolute_tolerances(d, d.solver.atol, 0);
-  OwnedVector atol_states(state_tolerances(P, atols, d.solver.atol, y.v));
-
-  const Timeline timeline(d);
-  std::vector<double> bounds = {t0};
-  for (double b : timeline.breaks)
-    if (b < tf) bounds.push_back(b);
-  bounds.push_back(tf);
-
-  RunStats& st = result.stats;
-  AdjointStats& as = st.adjoint;
-  as.used = true;
-  as.objectives = nm;
-  as.steps_between_checkpoints = options.steps_between_checkpoints;
-  as.segments = static_cast<int>(bounds.size()) - 1;
-  auto record = [&](double t) {
-    ev.outputs(t, NV_DATA_S(y.v));
-    recorder.record(t, NV_DATA_S(y.v), ev);
-  };
-  record(t0);
-
-  // A fresh forward problem from (start, y) with the run's settings, stopping at the segment's end.
-  auto open_forward = [&](Solver& S, const Chunk& c) {
-    ev.set_segment_start(c.segment_start);
-    S.mem = CVodeCreate(bdf ? CV_BDF : CV_ADAMS, C.ctx);
-    if (!S.mem) throw SolverError(c.start, "", "CVodeCreate failed");
-    set_up_forward(P, S.mem, C.ctx, c.start, y.v, atol_states.v, S.forward);
-    check(CVodeSetStopTime(S.mem, c.segment_stop), "CVodeSetStopTime", c.start);
-  };
-  auto add_forward_stats = [&](void* mem) {
-    long v = 0;
-    CVodeGetNumSteps(mem, &v), st.steps += v;
-    CVodeGetNumRhsEvals(mem, &v), st.rhs_evals += v;
-    CVodeGetNumErrTestFails(mem, &v), st.error_test_failures += v;
-    CVodeGetNumNonlinSolvIters(mem, &v), st.nonlinear_iterations += v;
-    CVodeGetNumNonlinSolvConvFails(mem, &v), st.nonlinear_failures += v;
-    if (bdf) CVodeGetNumJacEvals(mem, &v), st.jac_evals += v;
-  };
-  const bool backward = nm > 0 && ns > 0;
-  const long chunk_steps = std::max(options.steps_between_checkpoints, 1);
-
-  // the first pass: the outputs, and a checkpoint every chunk_steps steps (at an output time)
-  std::vector<Chunk> chunks;
-  size_t next_event = 0;
-  for (size_t k = 0; k + 1 < bounds.size(); ++k) {
-    Chunk c;
-    c.segment_start = c.start = bounds[k];
-    c.segment_stop = bounds[k + 1];
-    c.y0.assign(NV_DATA_S(y.v), NV_DATA_S(y.v) + n_cv);
-    auto S = std::make_unique<Solver>();
-    open_forward(*S, c);
-    while (next_event < timeline.events.size() && timeline.events[next_event] <= c.segment_stop) {
-      const double target = timeline.events[next_event++];
-      double reached = c.start;
-      check(CVode(S->mem, target, y.v, &reached, CV_NORMAL), "CVode", reached);
-      c.targets.push_back(target);
-      if (timeline.is_output(target)) record(target);
-      long steps = 0;
-      CVodeGetNumSteps(S->mem, &steps);
-      if (backward && steps >= chunk_steps && target < c.segment_stop) {
-        c.steps = steps;
-        add_forward_stats(S->mem);
-        chunks.push_back(c);
-        c.start = target;
-        c.targets.clear();
-        c.y0.assign(NV_DATA_S(y.v), NV_DATA_S(y.v) + n_cv);
-        S = std::make_unique<Solver>();
-        open_forward(*S, c);
-      }
-    }
-    CVodeGetNumSteps(S->mem, &c.steps);
-    add_forward_stats(S->mem);
-    if (!c.targets.empty()) chunks.push_back(std::move(c));
-  }
-  as.checkpoints = static_cast<long>(chunks.size());
-  as.forward_steps = st.steps;
-  st.local_jac_evals = P.local_refreshes;
-  st.jacobian_colours = P.colouring.colours();
-  as.forward_cpu_seconds = clock.seconds();
-
-  // the objectives' values and dG/dq at the end
-  std::vector<double> q(std::max(nq, 1), 0.0);
-  std::copy_n(NV_DATA_S(y.v) + nx, nq, q.data());
-  recorder.finish(q.data(), {});
-  result.final_state.assign(NV_DATA_S(y.v), NV_DATA_S(y.v) + nx);
-  for (int dir = 0; dir < ns; ++dir) result.sensitivity_names.push_back(d.parameters[d.sensitivities[dir]].name);
-  result.signal_sensitivities = false;
-  for (auto& o : result.objectives) o.sensitivity.assign(ns, 0.0);
-
-  if (nm > 0 && ns > 0) {
-    Backward B(P);
-    B.nm = nm, B.ns = ns;
-    B.g.assign(static_cast<size_t>(std::max(nq, 1)) * nm, 0.0);
-    ObjectiveSamples samples;
-    samples.t_start = t0, samples.t_stop = tf;
-    std::vector<double> scale(nm, 1.0);  // each objective's magnitude, for the tolerances
-    for (int m = 0; m < nm; ++m) {
-      const Node& n = d.nodes[d.objectives[m]];
-      const int nqn = n.block->num_quadratures();
-      if (nqn > 0 && !n.objective->quadrature_gradient(n.p.data(), q.data() + n.quad_offset, nqn, samples,
-                                                       B.g.data() + static_cast<size_t>(m) * nq + n.quad_offset))
-        throw InputError(n.file.empty() ? d.file : n.file, n.line, n.name, "objective " + n.name + " has no adjoint");
-      const double psi = std::fabs(result.objectives[m].value);
-      if (psi > 0 && std::isfinite(psi)) scale[m] = psi;
-    }
-    const int nb = nx * nm;
-    // tolerances: the gradient ~ psi / |p| (the forward run's pbar); lambda_i is the change of psi
-    // for a unit change of state i at time t, lambda_i ~ psi / nominal_i at most. Most states
-    // (pressures, wheel hop) move psi by a small fraction of it for a nominal-sized change, so
-    // lambda's atol is 1/100 of that bound: on the quarter car at rtol = atol = 1e-9 the
-    // gradients are 7e-6 off the converged ones with the bound itself, 8e-7 with 1/10 and 2e-7
-    // with 1/100 (for 50 % more backward time; docs/engine.md, Adjoint).
-    constexpr double kLambdaAtolFraction = 0.01;
-    const std::vector<double> nominal = state_nominals(d);
-    OwnedVector lambda(N_VNew_Serial(std::max(nb, 1), C.ctx)), atol_b(N_VNew_Serial(std::max(nb, 1), C.ctx));
-    OwnedVector grad(N_VNew_Serial(ns * nm, C.ctx)), atol_q(N_VNew_Serial(ns * nm, C.ctx));
-    N_VConst(0.0, lambda.v);
-    N_VConst(d.solver.atol, atol_b.v);
-    for (int m = 0; m < nm; ++m) {
-      for (int i = 0; i < nx; ++i)
-        NV_Ith_S(atol_b.v, m * nx + i) =
-            kLambdaAtolFraction * d.solver.atol * scale[m] / (d.solver.nominal_scaling ? nominal[i] : 1.0);
-      for (int dir = 0; dir < ns; ++dir) {
-        const double p = std::fabs(d.parameters[d.sensitivities[dir]].value);
-        NV_Ith_S(atol_q.v, m * ns + dir) = d.solver.atol * scale[m] / (p > 0 ? p : 1.0);
-      }
-    }
-    std::vector<double> gradient(static_cast<size_t>(ns) * nm, 0.0);
-    OwnedVector qB(N_VNew_Serial(ns * nm, C.ctx));
-    const CpuClock backward_clock;
-    long most_steps = 0;
-    for (size_t k = chunks.size(); k-- > 0;) {
-      const Chunk& c = chunks[k];
-      // the chunk's forward run again from its checkpoint, every step stored
-      std::copy(c.y0.begin(), c.y0.end(), NV_DATA_S(y.v));
-      Solver S;
-      open_forward(S, c);
-      void* mem = S.mem;
-      const long room = c.steps + std::max(16L, c.steps / 4);
-      most_steps = std::max(most_steps, room);
-      check(CVodeAdjInit(mem, room, CV_HERMITE), "CVodeAdjInit", c.start);
-      double reached = c.start;
-      for (double target : c.targets) {
-        int ncheck = 0;
-        check(CVodeF(mem, target, y.v, &reached, CV_NORMAL, &ncheck), "CVodeF", reached);
-      }
-      long replayed = 0;
-      CVodeGetNumSteps(mem, &replayed);
-      as.replay_steps += replayed;
-      if (replayed != c.steps) ++as.replays_differing;
-      // lambda back over the chunk
-      const double te = c.targets.back();
-      int which = 0;
-      check(CVodeCreateB(mem, bdf ? CV_BDF : CV_ADAMS, &which), "CVodeCreateB", te);
-      check(CVodeInitB(mem, which, backward_rhs, te, lambda.v), "CVodeInitB", te);
-      check(CVodeSetUserDataB(mem, which, &B), "CVodeSetUserDataB", te);
-      check(CVodeSVtolerancesB(mem, which, d.solver.rtol, atol_b.v), "CVodeSVtolerancesB", te);
-      check(CVodeSetMaxNumStepsB(mem, which, d.solver.max_steps), "CVodeSetMaxNumStepsB", te);
-      if (d.solver.max_order > 0) check(CVodeSetMaxOrdB(mem, which, d.solver.max_order), "CVodeSetMaxOrdB", te);
-      if (bdf) {
-        S.AB = SUNDenseMatrix(std::max(nb, 1), std::max(nb, 1), C.ctx);
-        S.LSB = SUNLinSol_Dense(lambda.v, S.AB, C.ctx);
-        check(CVodeSetLinearSolverB(mem, which, S.LSB, S.AB), "CVodeSetLinearSolverB", te);
-        check(CVodeSetJacFnB(mem, which, backward_jacobian), "CVodeSetJacFnB", te);
-      } else {
-        S.NLSB = SUNNonlinSol_FixedPoint(lambda.v, 0, C.ctx);
-        check(CVodeSetNonlinearSolverB(mem, which, S.NLSB), "CVodeSetNonlinearSolverB", te);
-      }
-      N_VConst(0.0, qB.v);
-      check(CVodeQuadInitB(mem, which, backward_quadrature, qB.v), "CVodeQuadInitB", te);
-      check(CVodeQuadSVtolerancesB(mem, which, d.solver.rtol, atol_q.v), "CVodeQuadSVtolerancesB", te);
-      check(CVodeSetQuadErrConB(mem, which, SUNTRUE), "CVodeSetQuadErrConB", te);
-      check(CVodeB(mem, c.start, CV_NORMAL), "CVodeB", te);
-      double tret = 0.0;
-      check(CVodeGetB(mem, which, &tret, lambda.v), "CVodeGetB", c.start);
-      check(CVodeGetQuadB(mem, which, &tret, qB.v), "CVodeGetQuadB", c.start);
-      for (int i = 0; i < ns * nm; ++i) gradient[i] += NV_Ith_S(qB.v, i);
-      void* memB = CVodeGetAdjCVodeBmem(mem, which);
-      long v = 0;
-      CVodeGetNumSteps(memB, &v), as.backward_steps += v;
-    }
-    // lambda(t0)^T dx0/dp
-    ev.set_segment_start(t0);
-    ev.initial_state_adjoint(t0, x0.data(), nm, {NV_DATA_S(lambda.v), nx}, {gradient.data(), ns});
-    for (int m = 0; m < nm; ++m)
-      for (int dir = 0; dir < ns; ++dir) {
-        const double g = gradient[static_cast<size_t>(m) * ns + dir];
-        if (!std::isfinite(g))
-          throw SolverError(t0, result.objectives[m].name, "the adjoint gradient is not finite (direction " +
-                                                               d.parameters[d.sensitivities[dir]].name + ")");
-        result.objectives[m].sensitivity[dir] = g;
-      }
-    as.backward_rhs_evals = B.rhs_passes;
-    as.backward_quadrature_evals = B.quadrature_passes;
-    as.backward_jac_evals = B.jac_passes;
-    as.backward_cpu_seconds = backward_clock.seconds();
-    // held: each checkpoint's state, and for the chunk being worked on y and y' at each of its
-    // steps (Hermite), in room for the most steps of a chunk
-    as.checkpoint_bytes = 8.0 * n_cv * (static_cast<double>(as.checkpoints) + 2.0 * (most_steps + 1));
-  }
-  struct rusage usage {};
-  if (getrusage(RUSAGE_SELF, &usage) == 0) as.peak_rss_bytes = 1024.0 * static_cast<double>(usage.ru_maxrss);
-
-  finish_cvodes_stats(st, d, clock.seconds());
-  return result;
+  return AdjointRun(d, options).run();
 }
 
 }  // namespace dydp::engine
