@@ -114,64 +114,94 @@ std::string plot_script(const std::string& out, const std::string& name, const s
   return gp.str();
 }
 
-}  // namespace
+/// One kc invocation: the scene's car, its kinematics and what is written, shared by the steps.
+class KcRun {
+ public:
+  explicit KcRun(const KcArgs& args) : args_(args), d_(engine::load_scene(args.scene, parse_sets(args.sets))) {}
 
-int kc_command(const KcArgs& args) {
-  engine::Diagram d = engine::load_scene(args.scene, parse_sets(args.sets));
-  print_warnings(d.warnings);
-  const CarBlock car = find_car(d, args.block);
-  const mbs::GeneratedModel& g = *car.model;
-  std::vector<double> p(g.parameter_values, g.parameter_values + g.parameters);
-  if (static_cast<int>(car.node->p.size()) >= g.parameters) std::copy_n(car.node->p.begin(), g.parameters, p.begin());
-  if (!(args.travel > 0) || args.travel > 0.3)
-    throw engine::InputError("--travel", 0, format(args.travel), "expected a wheel travel in (0, 0.3] m");
-  if (args.points < 3 || args.points % 2 == 0)
-    throw engine::InputError("--points", 0, std::to_string(args.points), "expected an odd number of points, at least 3");
-
-  const std::vector<Direction> dirs = directions(d, car);
-  mbs::KinematicsOptions o;
-  o.bump = args.travel;
-  o.bump_points = args.points;
-  std::map<int, int> column_of;  // model parameter -> derivative column
-  for (const auto& dir : dirs)
-    for (const int j : dir.model_parameters)
-      if (column_of.emplace(j, static_cast<int>(o.parameters.size())).second) o.parameters.push_back(j);
-
-  mbs::KinematicsResult r;
-  try {
-    r = mbs::suspension_kinematics(g, p, o);
-  } catch (const std::runtime_error& e) {
-    throw engine::InputError(d.file, car.node->line, car.node->name, e.what());
+  int run() {
+    set_up();
+    compute();
+    document();
+    write();
+    for (const auto& s : r_.sweeps) (s.name == "bump" ? bump_ : s.name == "roll" ? roll_ : steer_) = &s;
+    if (args_.report) report();
+    print_summary();
+    return 0;
   }
+
+ private:
+  // The car block, its model parameters and the sweep's settings checked.
+  void set_up() {
+    print_warnings(d_.warnings);
+    car_ = find_car(d_, args_.block);
+    const mbs::GeneratedModel& g = *car_.model;
+    p_.assign(g.parameter_values, g.parameter_values + g.parameters);
+    if (static_cast<int>(car_.node->p.size()) >= g.parameters)
+      std::copy_n(car_.node->p.begin(), g.parameters, p_.begin());
+    if (!(args_.travel > 0) || args_.travel > 0.3)
+      throw engine::InputError("--travel", 0, format(args_.travel), "expected a wheel travel in (0, 0.3] m");
+    if (args_.points < 3 || args_.points % 2 == 0)
+      throw engine::InputError("--points", 0, std::to_string(args_.points),
+                               "expected an odd number of points, at least 3");
+  }
+
+  // The derivative directions and the sweeps with the derivatives of their curves.
+  void compute() {
+    dirs_ = directions(d_, car_);
+    mbs::KinematicsOptions o;
+    o.bump = args_.travel;
+    o.bump_points = args_.points;
+    for (const auto& dir : dirs_)
+      for (const int j : dir.model_parameters)
+        if (column_of_.emplace(j, static_cast<int>(o.parameters.size())).second) o.parameters.push_back(j);
+
+    try {
+      r_ = mbs::suspension_kinematics(*car_.model, p_, o);
+    } catch (const std::runtime_error& e) {
+      throw engine::InputError(d_.file, car_.node->line, car_.node->name, e.what());
+    }
+  }
+
   // Derivatives per direction (summed over the model parameters it moves).
-  auto sensitivity = [&](const mbs::KinematicsCurve& c, const Direction& dir) {
+  std::vector<double> sensitivity(const mbs::KinematicsCurve& c, const Direction& dir) const {
     std::vector<double> s(c.values.size(), 0.0);
     for (const int j : dir.model_parameters)
-      for (size_t i = 0; i < s.size(); ++i) s[i] += c.sensitivity[static_cast<size_t>(column_of.at(j))][i];
+      for (size_t i = 0; i < s.size(); ++i) s[i] += c.sensitivity[static_cast<size_t>(column_of_.at(j))][i];
     return s;
-  };
+  }
 
-  Json doc;
-  doc["scene"] = d.file;
-  doc["block"] = car.node->name;
-  doc["model"] = g.name;
-  Json names = Json::array();
-  for (const auto& dir : dirs) names.push_back(dir.name);
-  doc["parameters"] = names;
-  doc["body"] = "held in its design attitude; wheel travel is the wheel centre's height from the design position";
-  Json corners = Json::array();
-  for (const auto& c : r.corners)
-    corners.push_back({{"name", c.name}, {"side", c.side > 0 ? "left" : "right"}, {"travel", g.coordinate_names[c.travel]}});
-  doc["corners"] = corners;
-  Json sweeps = Json::array();
-  std::map<std::string, std::string> csvs;
-  for (const auto& s : r.sweeps) {
+  // kc.json's document and the sweeps' CSV texts.
+  void document() {
+    const mbs::GeneratedModel& g = *car_.model;
+    doc_["scene"] = d_.file;
+    doc_["block"] = car_.node->name;
+    doc_["model"] = g.name;
+    Json names = Json::array();
+    for (const auto& dir : dirs_) names.push_back(dir.name);
+    doc_["parameters"] = names;
+    doc_["body"] = "held in its design attitude; wheel travel is the wheel centre's height from the design position";
+    Json corners = Json::array();
+    for (const auto& c : r_.corners)
+      corners.push_back({{"name", c.name},
+                         {"side", c.side > 0 ? "left" : "right"},
+                         {"travel", g.coordinate_names[c.travel]}});
+    doc_["corners"] = corners;
+    Json sweeps = Json::array();
+    for (const auto& s : r_.sweeps) sweeps.push_back(sweep(s));
+    doc_["sweeps"] = sweeps;
+    doc_["notes"] = r_.notes;
+    doc_["poses"] = r_.poses;
+  }
+
+  // One sweep's part of kc.json, its CSV text kept in csvs_.
+  Json sweep(const mbs::KinematicsSweep& s) {
     Json js{{"name", s.name}, {"variable", s.variable}, {"unit", s.unit}, {"x", s.x}};
     Json curves = Json::array();
     std::ostringstream csv;
     csv << std::setprecision(12) << s.variable << "_" << s.unit;
     for (const auto& c : s.curves) csv << "," << column(c) << "_" << c.unit;
-    for (const auto& dir : dirs)
+    for (const auto& dir : dirs_)
       for (const auto& c : s.curves) csv << ",d(" << column(c) << ")/d(" << dir.name << ")";
     csv << "\n";
     std::vector<std::vector<std::vector<double>>> sens;  // [curve][direction][point]
@@ -180,7 +210,7 @@ int kc_command(const KcArgs& args) {
               {"derivative", c.exact ? "exact" : "central differences of the exact rate"}};
       Json js_sens = Json::object();
       sens.emplace_back();
-      for (const auto& dir : dirs) {
+      for (const auto& dir : dirs_) {
         sens.back().push_back(sensitivity(c, dir));
         js_sens[dir.name] = sens.back().back();
       }
@@ -190,135 +220,165 @@ int kc_command(const KcArgs& args) {
     for (size_t i = 0; i < s.x.size(); ++i) {
       csv << s.x[i];
       for (const auto& c : s.curves) csv << "," << c.values[i];
-      for (size_t k = 0; k < dirs.size(); ++k)
+      for (size_t k = 0; k < dirs_.size(); ++k)
         for (size_t c = 0; c < s.curves.size(); ++c) csv << "," << sens[c][k][i];
       csv << "\n";
     }
     js["curves"] = curves;
-    sweeps.push_back(js);
-    csvs["kc_" + s.name + ".csv"] = csv.str();
-  }
-  doc["sweeps"] = sweeps;
-  doc["notes"] = r.notes;
-  doc["poses"] = r.poses;
-
-  // Everything computed: write.
-  std::filesystem::create_directories(args.out);
-  io::write_file_atomically(args.out + "/kc.json", doc.dump(2) + "\n");
-  std::string files = "kc.json";
-  for (const auto& [name, text] : csvs) {
-    io::write_file_atomically(args.out + "/" + name, text);
-    files += ", " + name;
-  }
-  if (args.format == "mat") {
-    io::MatFile mat(args.out + "/kc.mat");
-    mat.json("kc", doc);
-    mat.commit();
-    files += ", kc.mat";
+    csvs_["kc_" + s.name + ".csv"] = csv.str();
+    return js;
   }
 
-  const mbs::KinematicsSweep* bump = nullptr;
-  const mbs::KinematicsSweep* roll = nullptr;
-  const mbs::KinematicsSweep* steer = nullptr;
-  for (const auto& s : r.sweeps) (s.name == "bump" ? bump : s.name == "roll" ? roll : steer) = &s;
+  // kc.json, the CSVs and with --format mat kc.mat written; their names kept in files_.
+  void write() {
+    // Everything computed: write.
+    std::filesystem::create_directories(args_.out);
+    io::write_file_atomically(args_.out + "/kc.json", doc_.dump(2) + "\n");
+    files_ = "kc.json";
+    for (const auto& [name, text] : csvs_) {
+      io::write_file_atomically(args_.out + "/" + name, text);
+      files_ += ", " + name;
+    }
+    if (args_.format == "mat") {
+      io::MatFile mat(args_.out + "/kc.mat");
+      mat.json("kc", doc_);
+      mat.commit();
+      files_ += ", kc.mat";
+    }
+  }
 
-  if (args.report) {
+  // report.md: the plots, the design position's table and the derivatives' table.
+  void report() {
+    const mbs::GeneratedModel& g = *car_.model;
     std::ostringstream md;
-    md << "# " << d.scene_name << ": suspension kinematics of " << car.node->name << " (" << g.name << ")\n\n"
+    md << "# " << d_.scene_name << ": suspension kinematics of " << car_.node->name << " (" << g.name << ")\n\n"
        << "The body held in its design attitude; wheel travel is the wheel centre's height from the design "
           "position, all wheels together (bump +, rebound -). Toe-in and camber (top out) positive.\n\n";
-    if (have_gnuplot() && bump) {
-      std::filesystem::create_directories(args.out + "/plots");
-      auto columns_of = [&](const mbs::KinematicsSweep& s, const std::string& quantity) {
-        std::vector<std::pair<int, std::string>> cols;
-        for (size_t c = 0; c < s.curves.size(); ++c)
-          if (s.curves[c].quantity == quantity) cols.push_back({static_cast<int>(c) + 2, s.curves[c].corner});
-        return cols;
+    if (have_gnuplot() && bump_) report_plots(md);
+    if (bump_) report_design(md);
+    report_derivatives(md);
+    io::write_file_atomically(args_.out + "/report.md", md.str());
+    files_ += ", report.md";
+  }
+
+  // The bump sweep's plots drawn by gnuplot, each that was drawn linked in md.
+  void report_plots(std::ostringstream& md) const {
+    std::filesystem::create_directories(args_.out + "/plots");
+    auto columns_of = [&](const mbs::KinematicsSweep& s, const std::string& quantity) {
+      std::vector<std::pair<int, std::string>> cols;
+      for (size_t c = 0; c < s.curves.size(); ++c)
+        if (s.curves[c].quantity == quantity) cols.push_back({static_cast<int>(c) + 2, s.curves[c].corner});
+      return cols;
+    };
+    const std::vector<std::tuple<std::string, std::string, std::string, bool>> plots = {
+        {"toe", "bump steer: toe-in [deg]", "kc_bump_steer", true},
+        {"camber", "camber [deg]", "kc_camber", true},
+        {"spring_ratio", "spring motion ratio [-]", "kc_spring_ratio", false},
+        {"roll_centre_height", "roll centre height above the contact [m]", "kc_roll_centre", false}};
+    for (const auto& [quantity, label, name, vertical] : plots) {
+      const auto cols = columns_of(*bump_, quantity);
+      if (cols.empty()) continue;
+      if (run_gnuplot(args_.out, name, plot_script(args_.out, name, label + " against wheel travel",
+                                                   "wheel travel [mm]", label, "kc_bump.csv", cols, vertical, 1000.0)))
+        md << "![" << name << "](plots/" << name << ".png)\n\n";
+    }
+  }
+
+  // The table of each corner's bump curves at the design position.
+  void report_design(std::ostringstream& md) const {
+    md << "| corner | toe [deg] | camber [deg] | bump steer [deg/m] | camber gain [deg/m] | spring ratio | "
+          "damper ratio | roll centre [mm] |\n|---|---|---|---|---|---|---|---|\n";
+    for (const auto& c : r_.corners) {
+      auto value = [&](const std::string& q) {
+        const auto* curve = find_curve(*bump_, q, c.name);
+        return curve ? format(at_design(*curve)) : std::string("-");
       };
-      const std::vector<std::tuple<std::string, std::string, std::string, bool>> plots = {
-          {"toe", "bump steer: toe-in [deg]", "kc_bump_steer", true},
-          {"camber", "camber [deg]", "kc_camber", true},
-          {"spring_ratio", "spring motion ratio [-]", "kc_spring_ratio", false},
-          {"roll_centre_height", "roll centre height above the contact [m]", "kc_roll_centre", false}};
-      for (const auto& [quantity, label, name, vertical] : plots) {
-        const auto cols = columns_of(*bump, quantity);
-        if (cols.empty()) continue;
-        if (run_gnuplot(args.out, name, plot_script(args.out, name, label + " against wheel travel",
-                                                    "wheel travel [mm]", label, "kc_bump.csv", cols, vertical, 1000.0)))
-          md << "![" << name << "](plots/" << name << ".png)\n\n";
-      }
+      const auto* rch = find_curve(*bump_, "roll_centre_height", c.name);
+      md << "| " << c.name << " | " << value("toe") << " | " << value("camber") << " | " << value("bump_steer") << " | "
+         << value("camber_gain") << " | " << value("spring_ratio") << " | " << value("damper_ratio") << " | "
+         << (rch ? format(1000 * at_design(*rch)) : "-") << " |\n";
     }
-    if (bump) {
-      md << "| corner | toe [deg] | camber [deg] | bump steer [deg/m] | camber gain [deg/m] | spring ratio | damper ratio | "
-            "roll centre [mm] |\n|---|---|---|---|---|---|---|---|\n";
-      for (const auto& c : r.corners) {
-        auto value = [&](const std::string& q) {
-          const auto* curve = find_curve(*bump, q, c.name);
-          return curve ? format(at_design(*curve)) : std::string("-");
-        };
-        const auto* rch = find_curve(*bump, "roll_centre_height", c.name);
-        md << "| " << c.name << " | " << value("toe") << " | " << value("camber") << " | " << value("bump_steer") << " | "
-           << value("camber_gain") << " | " << value("spring_ratio") << " | " << value("damper_ratio") << " | "
-           << (rch ? format(1000 * at_design(*rch)) : "-") << " |\n";
-      }
-      md << "\n";
-    }
+    md << "\n";
+  }
+
+  // The table of the bump curves' derivatives at the design position, per direction.
+  void report_derivatives(std::ostringstream& md) const {
     md << "Derivatives at the design position with respect to the scene's geometry parameters and directions "
           "(position-level curves exact; rates by central differences of their exact values); the quantities "
           "no direction moves are left out:\n\n"
        << "| quantity | corner |";
-    for (const auto& dir : dirs) md << " d/d(" << dir.name << ") |";
+    for (const auto& dir : dirs_) md << " d/d(" << dir.name << ") |";
     md << "\n|---|---|";
-    for (size_t k = 0; k < dirs.size(); ++k) md << "---|";
+    for (size_t k = 0; k < dirs_.size(); ++k) md << "---|";
     md << "\n";
-    if (bump)
-      for (const auto& c : bump->curves) {
-        const bool moved = std::any_of(dirs.begin(), dirs.end(), [&](const Direction& dir) {
+    if (bump_)
+      for (const auto& c : bump_->curves) {
+        const bool moved = std::any_of(dirs_.begin(), dirs_.end(), [&](const Direction& dir) {
           return sensitivity(c, dir)[c.values.size() / 2] != 0.0;
         });
         if (!moved) continue;  // toe and camber: no direction of the scene moves the linkage
         md << "| " << c.quantity << " [" << c.unit << "] | " << c.corner << " |";
-        for (const auto& dir : dirs) md << " " << format(sensitivity(c, dir)[c.values.size() / 2], 3) << " |";
+        for (const auto& dir : dirs_) md << " " << format(sensitivity(c, dir)[c.values.size() / 2], 3) << " |";
         md << "\n";
       }
-    io::write_file_atomically(args.out + "/report.md", md.str());
-    files += ", report.md";
   }
 
-  std::cout << d.scene_name << ": suspension kinematics of " << car.node->name << " (" << g.name << "), "
-            << r.corners.size() << " corners, " << r.sweeps.size() << " sweeps, " << r.poses << " poses\n";
-  if (bump) {
-    std::cout << "  at the design position          toe     camber  bump steer  camber gain  spring  damper  roll centre\n"
-                 "                                  [deg]   [deg]   [deg/m]     [deg/m]      ratio   ratio   [mm]\n";
-    for (const auto& c : r.corners) {
-      auto value = [&](const std::string& q, double scale = 1.0) {
-        const auto* curve = find_curve(*bump, q, c.name);
-        return curve ? at_design(*curve) * scale : std::nan("");
-      };
-      std::cout << "  " << std::left << std::setw(30) << c.name << std::right << std::fixed << std::setprecision(3)
-                << std::setw(8) << value("toe") << std::setw(8) << value("camber") << std::setw(10)
-                << value("bump_steer") << std::setw(13) << value("camber_gain") << std::setw(9)
-                << value("spring_ratio") << std::setw(8) << value("damper_ratio") << std::setw(11)
-                << value("roll_centre_height", 1000.0) << "\n"
-                << std::defaultfloat;
+  // The summary on stdout: the design position, roll and steering gains, notes and the files written.
+  void print_summary() const {
+    const mbs::GeneratedModel& g = *car_.model;
+    std::cout << d_.scene_name << ": suspension kinematics of " << car_.node->name << " (" << g.name << "), "
+              << r_.corners.size() << " corners, " << r_.sweeps.size() << " sweeps, " << r_.poses << " poses\n";
+    if (bump_) {
+      std::cout << "  at the design position          toe     camber  bump steer  camber gain  spring  damper  "
+                   "roll centre\n"
+                   "                                  [deg]   [deg]   [deg/m]     [deg/m]      ratio   ratio   [mm]\n";
+      for (const auto& c : r_.corners) {
+        auto value = [&](const std::string& q, double scale = 1.0) {
+          const auto* curve = find_curve(*bump_, q, c.name);
+          return curve ? at_design(*curve) * scale : std::nan("");
+        };
+        std::cout << "  " << std::left << std::setw(30) << c.name << std::right << std::fixed << std::setprecision(3)
+                  << std::setw(8) << value("toe") << std::setw(8) << value("camber") << std::setw(10)
+                  << value("bump_steer") << std::setw(13) << value("camber_gain") << std::setw(9)
+                  << value("spring_ratio") << std::setw(8) << value("damper_ratio") << std::setw(11)
+                  << value("roll_centre_height", 1000.0) << "\n"
+                  << std::defaultfloat;
+      }
     }
+    if (roll_)
+      for (const auto& c : r_.corners) {
+        const auto* st = find_curve(*roll_, "roll_steer", c.name);
+        const auto* ca = find_curve(*roll_, "roll_camber", c.name);
+        if (st && ca)
+          std::cout << "  roll " << c.name << ": roll steer " << format(at_design(*st), 3) << " deg/deg, roll camber "
+                    << format(at_design(*ca), 3) << " deg/deg\n";
+      }
+    if (steer_)
+      for (const auto& curve : steer_->curves)
+        if (curve.quantity == "steering_gain")
+          std::cout << "  steer " << curve.corner << ": " << format(at_design(curve) / 1000.0, 4) << " deg per mm of "
+                    << steer_->variable << "\n";
+    for (const auto& note : r_.notes) std::cout << "  note: " << note << "\n";
+    std::cout << "wrote " << args_.out << "/: " << files_ << "\n";
   }
-  if (roll)
-    for (const auto& c : r.corners) {
-      const auto* st = find_curve(*roll, "roll_steer", c.name);
-      const auto* ca = find_curve(*roll, "roll_camber", c.name);
-      if (st && ca)
-        std::cout << "  roll " << c.name << ": roll steer " << format(at_design(*st), 3) << " deg/deg, roll camber "
-                  << format(at_design(*ca), 3) << " deg/deg\n";
-    }
-  if (steer)
-    for (const auto& curve : steer->curves)
-      if (curve.quantity == "steering_gain")
-        std::cout << "  steer " << curve.corner << ": " << format(at_design(curve) / 1000.0, 4) << " deg per mm of "
-                  << steer->variable << "\n";
-  for (const auto& note : r.notes) std::cout << "  note: " << note << "\n";
-  std::cout << "wrote " << args.out << "/: " << files << "\n";
-  return 0;
-}
+
+  const KcArgs& args_;
+  engine::Diagram d_;
+  CarBlock car_;
+  std::vector<double> p_;  // the car model's parameter values in the scene
+  std::vector<Direction> dirs_;
+  std::map<int, int> column_of_;  // model parameter -> derivative column
+  mbs::KinematicsResult r_;
+  Json doc_;
+  std::map<std::string, std::string> csvs_;  // file name -> text
+  std::string files_;                        // the files written, for the summary
+  const mbs::KinematicsSweep* bump_ = nullptr;
+  const mbs::KinematicsSweep* roll_ = nullptr;
+  const mbs::KinematicsSweep* steer_ = nullptr;
+};
+
+}  // namespace
+
+int kc_command(const KcArgs& args) { return KcRun(args).run(); }
 
 }  // namespace dydp::apps
