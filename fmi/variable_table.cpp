@@ -50,178 +50,225 @@ std::string token_of(const VariableTable& t) {
   return text;
 }
 
-}  // namespace
+/// The table of one FMU being built: the scene, its description and what the steps share.
+class TableBuilder {
+ public:
+  TableBuilder(Diagram& d, const Exposure& e) : d_(d), e_(e) {}
 
-VariableTable build_variables(Diagram& d, const Exposure& e) {
-  VariableTable t;
-  auto add = [&t](Variable v) {
-    v.value_reference = static_cast<uint32_t>(t.variables.size());
-    t.variables.push_back(std::move(v));
-    return t.variables.back().value_reference;
-  };
-  add(variable("time", Role::time, 0, "s", "simulation time"));
+  VariableTable build() {
+    add(variable("time", Role::time, 0, "s", "simulation time"));
+    add_parameters();
+    add_inputs();
+    add_states();
+    add_dependencies();
+    add_outputs();
+    add_event_indicators();
+    t_.token = token_of(t_);
+    return std::move(t_);
+  }
 
-  // Parameters: the scene's (all by default), tunable, with their units and ranges.
-  if (e.default_parameters) {
-    for (int i = 0; i < static_cast<int>(d.parameters.size()); ++i) t.parameters.push_back(i);
-  } else {
-    for (const ExposedName& p : e.parameters) {
-      const int i = d.find_parameter(p.name);
-      if (i < 0) {
-        std::string names;
-        for (const auto& sp : d.parameters) names += (names.empty() ? "" : ", ") + sp.name;
-        throw InputError(e.spec_file, p.line, "parameters",
-                         "no scene parameter " + p.name + " (the scene's: " + (names.empty() ? "none" : names) + ")");
+ private:
+  // v appended with the next value reference, which it returns.
+  uint32_t add(Variable v) {
+    v.value_reference = static_cast<uint32_t>(t_.variables.size());
+    t_.variables.push_back(std::move(v));
+    return t_.variables.back().value_reference;
+  }
+
+  // The exposed scene parameters, and those differentiable made the scene's sensitivities.
+  void add_parameters() {
+    // Parameters: the scene's (all by default), tunable, with their units and ranges.
+    if (e_.default_parameters) {
+      for (int i = 0; i < static_cast<int>(d_.parameters.size()); ++i) t_.parameters.push_back(i);
+    } else {
+      for (const ExposedName& p : e_.parameters) {
+        const int i = d_.find_parameter(p.name);
+        if (i < 0) {
+          std::string names;
+          for (const auto& sp : d_.parameters) names += (names.empty() ? "" : ", ") + sp.name;
+          throw InputError(e_.spec_file, p.line, "parameters",
+                           "no scene parameter " + p.name + " (the scene's: " + (names.empty() ? "none" : names) + ")");
+        }
+        t_.parameters.push_back(i);
       }
-      t.parameters.push_back(i);
     }
-  }
-  const std::vector<int> differentiable = engine::differentiable_parameters(d);
-  for (int i : t.parameters) {
-    const engine::SceneParameter& sp = d.parameters[i];
-    Variable v = variable(sp.name, Role::parameter, i, sp.unit, "scene parameter");
-    v.has_start = true;
-    v.start = sp.value;
-    v.min = sp.lower;
-    v.max = sp.upper;
-    add(v);
-    if (std::find(differentiable.begin(), differentiable.end(), i) != differentiable.end())
-      t.differentiable.push_back(i);
-  }
-  d.set_sensitivities(t.differentiable);
-
-  // Inputs: signals whose wire is cut, their value the importer's; the start value is the
-  // scene's own at time.start.
-  engine::Evaluator ev(d, false);
-  std::vector<double> x0(std::max(d.num_states, 1), 0.0);
-  ev.set_segment_start(d.time.start);
-  ev.initial_state(d.time.start, x0.data());
-  ev.outputs(d.time.start, x0.data());
-  std::set<int> input_set;
-  for (const ExposedName& in : e.inputs) {
-    std::vector<int> offsets;
-    try {
-      offsets = engine::signal_offsets(d, in.name, "inputs");
-    } catch (const InputError& error) {
-      rethrow_at(e, in.line, "inputs", error);
-    }
-    for (int offset : offsets) {
-      if (!input_set.insert(offset).second)
-        throw InputError(e.spec_file, in.line, "inputs", engine::signal_name(d, offset) + " is an input twice");
-      Variable v = variable(engine::signal_name(d, offset), Role::input, static_cast<int>(t.input_offsets.size()),
-                            d.signal_unit(offset), "input (the scene's signal, its wire cut)");
+    const std::vector<int> differentiable = engine::differentiable_parameters(d_);
+    for (int i : t_.parameters) {
+      const engine::SceneParameter& sp = d_.parameters[i];
+      Variable v = variable(sp.name, Role::parameter, i, sp.unit, "scene parameter");
       v.has_start = true;
-      v.start = ev.signals()[offset];
-      t.input_offsets.push_back(offset);
+      v.start = sp.value;
+      v.min = sp.lower;
+      v.max = sp.upper;
       add(v);
+      if (std::find(differentiable.begin(), differentiable.end(), i) != differentiable.end())
+        t_.differentiable.push_back(i);
     }
+    d_.set_sensitivities(t_.differentiable);
   }
 
-  // States: the blocks', then the objectives' quadratures (their integrals).
-  t.num_block_states = d.num_states;
-  t.num_quadratures = d.num_quadratures;
-  std::vector<std::string> state_names(t.num_states());
-  t.nominals.assign(t.num_states(), 1.0);
-  for (const Node& n : d.nodes) {
-    for (int k = 0; k < n.block->num_states(); ++k) {
-      state_names[n.state_offset + k] = n.name + ".state." + n.block->state_names()[k];
-      t.nominals[n.state_offset + k] =
-          k < static_cast<int>(n.state_nominal.size()) ? n.state_nominal[k] : n.block->state_nominals()[k];
-    }
-    for (int k = 0; k < n.block->num_quadratures(); ++k) {
-      state_names[d.num_states + n.quad_offset + k] = n.name + ".integral[" + std::to_string(k) + "]";
-      t.nominals[d.num_states + n.quad_offset + k] = n.block->quadrature_nominals()[k];
-    }
-  }
-  t.first_state = static_cast<uint32_t>(t.variables.size());
-  for (int i = 0; i < t.num_states(); ++i) {
-    add(variable(state_names[i], Role::state, i, "",
-                 i < d.num_states ? "continuous state" : "integral of an objective's integrand"));
-  }
-  t.first_derivative = static_cast<uint32_t>(t.variables.size());
-  for (int i = 0; i < t.num_states(); ++i) add(variable("der(" + state_names[i] + ")", Role::derivative, i));
-
-  // Dependencies from the diagram's structure: an output step's outputs read its block's own
-  // states and the inputs it reads (Block::output_reads); a held input depends on itself only.
-  std::vector<std::set<uint32_t>> signal_deps(d.num_signals);
-  std::vector<int> input_of(d.num_signals, -1);
-  for (size_t j = 0; j < t.input_offsets.size(); ++j) input_of[t.input_offsets[j]] = static_cast<int>(j);
-  const uint32_t first_input = static_cast<uint32_t>(1 + t.parameters.size());
-  auto own_states = [&](const Node& n) {
-    std::set<uint32_t> deps;
-    for (int k = 0; k < n.block->num_states(); ++k) deps.insert(t.first_state + n.state_offset + k);
-    return deps;
-  };
-  for (const engine::OutputStep& step : d.output_steps) {
-    const Node& n = d.nodes[step.node];
-    std::set<uint32_t> deps = own_states(n);
-    for (int k : step.reads) deps.insert(signal_deps[n.input_source[k]].begin(), signal_deps[n.input_source[k]].end());
-    for (int k : step.outputs)
-      for (int w = 0; w < n.block->outputs()[k].width; ++w) {
-        const int offset = n.output_offset[k] + w;
-        signal_deps[offset] = input_of[offset] >= 0 ? std::set<uint32_t>{first_input + input_of[offset]} : deps;
-      }
-  }
-  std::vector<std::set<uint32_t>> state_deps(t.num_states());
-  for (const Node& n : d.nodes) {
-    std::set<uint32_t> deps = own_states(n);
-    for (int src : n.input_source) deps.insert(signal_deps[src].begin(), signal_deps[src].end());
-    for (int k = 0; k < n.block->num_states(); ++k) state_deps[n.state_offset + k] = deps;
-    for (int k = 0; k < n.block->num_quadratures(); ++k) state_deps[d.num_states + n.quad_offset + k] = deps;
-  }
-  for (int i = 0; i < t.num_states(); ++i)
-    t.variables[t.first_derivative + i].dependencies.assign(state_deps[i].begin(), state_deps[i].end());
-
-  // Outputs: the logged signals and requested objectives by default, else the named ones.
-  auto add_signal_output = [&](int offset) {
-    Variable v = variable(engine::signal_name(d, offset), Role::output_signal, offset, d.signal_unit(offset), "signal");
-    v.dependencies.assign(signal_deps[offset].begin(), signal_deps[offset].end());
-    add(v);
-  };
-  auto add_objective_output = [&](int node, int line) {
-    const Node& n = d.nodes[node];
-    if (n.objective->needs_samples())
-      throw InputError(e.spec_file, line, "outputs",
-                       "objective " + n.name + " needs its input sampled over the run (" + n.type->name +
-                           "): an FMU gives only objectives made of integrals");
-    Variable v = variable(n.name, Role::output_objective, node, d.objective_unit(n),
-                          "objective from its integrals so far (the run's value at the stop time)");
-    for (int k = 0; k < n.block->num_quadratures(); ++k)
-      v.dependencies.push_back(t.first_state + d.num_states + n.quad_offset + k);
-    add(v);
-  };
-  std::set<std::string> output_names;
-  if (e.default_outputs) {
-    for (const engine::LoggedSignal& s : d.logged) add_signal_output(s.offset);
-    for (int node : d.objectives) add_objective_output(node, 0);
-  } else {
-    for (const ExposedName& out : e.outputs) {
-      const int node = find_objective(d, out.name);
-      if (node >= 0) {
-        add_objective_output(node, out.line);
-        continue;
-      }
+  // The exposed inputs, each starting at the scene's value of its signal.
+  void add_inputs() {
+    // Inputs: signals whose wire is cut, their value the importer's; the start value is the
+    // scene's own at time.start.
+    engine::Evaluator ev(d_, false);
+    std::vector<double> x0(std::max(d_.num_states, 1), 0.0);
+    ev.set_segment_start(d_.time.start);
+    ev.initial_state(d_.time.start, x0.data());
+    ev.outputs(d_.time.start, x0.data());
+    std::set<int> input_set;
+    for (const ExposedName& in : e_.inputs) {
       std::vector<int> offsets;
       try {
-        offsets = engine::signal_offsets(d, out.name, "outputs");
+        offsets = engine::signal_offsets(d_, in.name, "inputs");
       } catch (const InputError& error) {
-        rethrow_at(e, out.line, "outputs", error);
+        rethrow_at(e_, in.line, "inputs", error);
       }
-      for (int offset : offsets) add_signal_output(offset);
+      for (int offset : offsets) {
+        if (!input_set.insert(offset).second)
+          throw InputError(e_.spec_file, in.line, "inputs", engine::signal_name(d_, offset) + " is an input twice");
+        Variable v = variable(engine::signal_name(d_, offset), Role::input, static_cast<int>(t_.input_offsets.size()),
+                              d_.signal_unit(offset), "input (the scene's signal, its wire cut)");
+        v.has_start = true;
+        v.start = ev.signals()[offset];
+        t_.input_offsets.push_back(offset);
+        add(v);
+      }
     }
   }
-  for (const Variable& v : t.variables)
-    if (!output_names.insert(v.name).second)
-      throw InputError(e.spec_file, 0, "outputs", "two variables of the FMU are named " + v.name);
 
-  // Event indicators: t - t_b for each breakpoint of the blocks over the scene's time span.
-  t.breakpoints = d.breakpoints(d.time.start, d.time.stop);
-  for (size_t k = 0; k < t.breakpoints.size(); ++k) {
-    add(variable("breakpoint[" + std::to_string(k) + "]", Role::event_indicator, static_cast<int>(k), "s",
-                 "time minus a block's breakpoint (" + engine::format_number(t.breakpoints[k]) + " s)"));
+  // The states with their names and nominal magnitudes, then their derivatives.
+  void add_states() {
+    // States: the blocks', then the objectives' quadratures (their integrals).
+    t_.num_block_states = d_.num_states;
+    t_.num_quadratures = d_.num_quadratures;
+    std::vector<std::string> state_names(t_.num_states());
+    t_.nominals.assign(t_.num_states(), 1.0);
+    for (const Node& n : d_.nodes) {
+      for (int k = 0; k < n.block->num_states(); ++k) {
+        state_names[n.state_offset + k] = n.name + ".state." + n.block->state_names()[k];
+        t_.nominals[n.state_offset + k] =
+            k < static_cast<int>(n.state_nominal.size()) ? n.state_nominal[k] : n.block->state_nominals()[k];
+      }
+      for (int k = 0; k < n.block->num_quadratures(); ++k) {
+        state_names[d_.num_states + n.quad_offset + k] = n.name + ".integral[" + std::to_string(k) + "]";
+        t_.nominals[d_.num_states + n.quad_offset + k] = n.block->quadrature_nominals()[k];
+      }
+    }
+    t_.first_state = static_cast<uint32_t>(t_.variables.size());
+    for (int i = 0; i < t_.num_states(); ++i) {
+      add(variable(state_names[i], Role::state, i, "",
+                   i < d_.num_states ? "continuous state" : "integral of an objective's integrand"));
+    }
+    t_.first_derivative = static_cast<uint32_t>(t_.variables.size());
+    for (int i = 0; i < t_.num_states(); ++i) add(variable("der(" + state_names[i] + ")", Role::derivative, i));
   }
-  t.token = token_of(t);
-  return t;
-}
+
+  // The value references of n's own states.
+  std::set<uint32_t> own_states(const Node& n) const {
+    std::set<uint32_t> deps;
+    for (int k = 0; k < n.block->num_states(); ++k) deps.insert(t_.first_state + n.state_offset + k);
+    return deps;
+  }
+
+  // Each signal's dependencies (kept for the outputs) and each derivative's.
+  void add_dependencies() {
+    // Dependencies from the diagram's structure: an output step's outputs read its block's own
+    // states and the inputs it reads (Block::output_reads); a held input depends on itself only.
+    signal_deps_.assign(d_.num_signals, {});
+    std::vector<int> input_of(d_.num_signals, -1);
+    for (size_t j = 0; j < t_.input_offsets.size(); ++j) input_of[t_.input_offsets[j]] = static_cast<int>(j);
+    const uint32_t first_input = static_cast<uint32_t>(1 + t_.parameters.size());
+    for (const engine::OutputStep& step : d_.output_steps) {
+      const Node& n = d_.nodes[step.node];
+      std::set<uint32_t> deps = own_states(n);
+      for (int k : step.reads)
+        deps.insert(signal_deps_[n.input_source[k]].begin(), signal_deps_[n.input_source[k]].end());
+      for (int k : step.outputs)
+        for (int w = 0; w < n.block->outputs()[k].width; ++w) {
+          const int offset = n.output_offset[k] + w;
+          signal_deps_[offset] = input_of[offset] >= 0 ? std::set<uint32_t>{first_input + input_of[offset]} : deps;
+        }
+    }
+    std::vector<std::set<uint32_t>> state_deps(t_.num_states());
+    for (const Node& n : d_.nodes) {
+      std::set<uint32_t> deps = own_states(n);
+      for (int src : n.input_source) deps.insert(signal_deps_[src].begin(), signal_deps_[src].end());
+      for (int k = 0; k < n.block->num_states(); ++k) state_deps[n.state_offset + k] = deps;
+      for (int k = 0; k < n.block->num_quadratures(); ++k) state_deps[d_.num_states + n.quad_offset + k] = deps;
+    }
+    for (int i = 0; i < t_.num_states(); ++i)
+      t_.variables[t_.first_derivative + i].dependencies.assign(state_deps[i].begin(), state_deps[i].end());
+  }
+
+  // The signal at offset as an output, with its dependencies.
+  void add_signal_output(int offset) {
+    Variable v =
+        variable(engine::signal_name(d_, offset), Role::output_signal, offset, d_.signal_unit(offset), "signal");
+    v.dependencies.assign(signal_deps_[offset].begin(), signal_deps_[offset].end());
+    add(v);
+  }
+
+  // The objective of node `node` as an output (refused at the description's line unless made of integrals).
+  void add_objective_output(int node, int line) {
+    const Node& n = d_.nodes[node];
+    if (n.objective->needs_samples())
+      throw InputError(e_.spec_file, line, "outputs",
+                       "objective " + n.name + " needs its input sampled over the run (" + n.type->name +
+                           "): an FMU gives only objectives made of integrals");
+    Variable v = variable(n.name, Role::output_objective, node, d_.objective_unit(n),
+                          "objective from its integrals so far (the run's value at the stop time)");
+    for (int k = 0; k < n.block->num_quadratures(); ++k)
+      v.dependencies.push_back(t_.first_state + d_.num_states + n.quad_offset + k);
+    add(v);
+  }
+
+  // The outputs, and the check that no two variables share a name.
+  void add_outputs() {
+    // Outputs: the logged signals and requested objectives by default, else the named ones.
+    std::set<std::string> output_names;
+    if (e_.default_outputs) {
+      for (const engine::LoggedSignal& s : d_.logged) add_signal_output(s.offset);
+      for (int node : d_.objectives) add_objective_output(node, 0);
+    } else {
+      for (const ExposedName& out : e_.outputs) {
+        const int node = find_objective(d_, out.name);
+        if (node >= 0) {
+          add_objective_output(node, out.line);
+          continue;
+        }
+        std::vector<int> offsets;
+        try {
+          offsets = engine::signal_offsets(d_, out.name, "outputs");
+        } catch (const InputError& error) {
+          rethrow_at(e_, out.line, "outputs", error);
+        }
+        for (int offset : offsets) add_signal_output(offset);
+      }
+    }
+    for (const Variable& v : t_.variables)
+      if (!output_names.insert(v.name).second)
+        throw InputError(e_.spec_file, 0, "outputs", "two variables of the FMU are named " + v.name);
+  }
+
+  // One event indicator per breakpoint.
+  void add_event_indicators() {
+    // Event indicators: t - t_b for each breakpoint of the blocks over the scene's time span.
+    t_.breakpoints = d_.breakpoints(d_.time.start, d_.time.stop);
+    for (size_t k = 0; k < t_.breakpoints.size(); ++k) {
+      add(variable("breakpoint[" + std::to_string(k) + "]", Role::event_indicator, static_cast<int>(k), "s",
+                   "time minus a block's breakpoint (" + engine::format_number(t_.breakpoints[k]) + " s)"));
+    }
+  }
+
+  Diagram& d_;
+  const Exposure& e_;
+  VariableTable t_;
+  std::vector<std::set<uint32_t>> signal_deps_;  // per signal: the value references it depends on
+};
+
+}  // namespace
+
+VariableTable build_variables(Diagram& d, const Exposure& e) { return TableBuilder(d, e).build(); }
 
 }  // namespace dydp::fmi
