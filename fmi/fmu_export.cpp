@@ -49,9 +49,6 @@ ExportSummary export_fmu(const ExportOptions& o) {
   if (!o.model_exchange && !o.co_simulation) throw InputError("--kind", 0, "", "neither Model Exchange nor Co-Simulation");
   const Exposure e = read_exposure(o.source);
   engine::Diagram d = engine::load_scene(e.scene_file);
-  if (d.initial.equilibrium)
-    throw InputError(e.scene_file, d.initial.line, "initial",
-                     "an FMU starts from its blocks' initial states: `initial: equilibrium` is not exported (docs/fmi.md)");
   const VariableTable t = build_variables(d, e);
 
   ExportSummary summary;

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "engine/framework/errors.hpp"
+#include "engine/studies/initial_equilibrium.hpp"
 
 namespace dydp::fmi {
 
@@ -37,6 +38,9 @@ void FmuModel::start(double t0, double stop) {
   t_ = t0;
   stop_ = stop;
   set_segment_start(t0);
+  // `initial: equilibrium`: the static equilibrium at t0 with the inputs held at the importer's
+  // values and the parameters as it set them (the blocks' initial states otherwise).
+  engine::start_at_equilibrium(*diagram_, t0, held_);
   std::vector<double> x0(std::max(diagram_->num_states, 1), 0.0);
   ev_->initial_state(t0, x0.data());
   std::fill(x_.begin(), x_.end(), 0.0);

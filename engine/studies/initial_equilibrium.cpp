@@ -1,5 +1,7 @@
 #include "engine/studies/initial_equilibrium.hpp"
 
+#include <algorithm>
+
 #include "engine/analysis/error_estimate.hpp"
 #include "engine/framework/errors.hpp"
 
@@ -8,10 +10,20 @@ namespace dydp::engine {
 std::optional<Equilibrium> start_at_equilibrium(Diagram& d) {
   // A diagram without states starts where it is.
   if (!d.initial.equilibrium || d.num_states == 0 || d.start_is_current()) return std::nullopt;
+  return start_at_equilibrium(d, d.time.start, {});
+}
+
+std::optional<Equilibrium> start_at_equilibrium(Diagram& d, double t, const std::vector<std::pair<int, double>>& held) {
+  if (!d.initial.equilibrium || d.num_states == 0) return std::nullopt;
   d.start = StartState{};  // Newton starts from the blocks' own initial states
   EquilibriumOptions o;
-  o.time = d.time.start;
+  o.time = t;
   o.held = d.initial.held;
+  for (const auto& h : held) {
+    const auto same = [&](const std::pair<int, double>& g) { return g.first == h.first; };
+    if (const auto it = std::find_if(o.held.begin(), o.held.end(), same); it != o.held.end()) it->second = h.second;
+    else o.held.push_back(h);
+  }
   Equilibrium eq;
   try {
     eq = find_equilibrium(d, o);
@@ -22,7 +34,7 @@ std::optional<Equilibrium> start_at_equilibrium(Diagram& d) {
   s.x = eq.x;
   s.parameters = eq.parameters;
   s.dx_dp.assign(eq.dx_dp.data(), eq.dx_dp.data() + eq.dx_dp.size());  // column-major: column c at c * n
-  s.t = d.time.start;
+  s.t = t;
   s.block_parameters = d.block_parameter_values();
   d.start = std::move(s);
   return eq;

@@ -21,6 +21,12 @@ namespace dydp::engine {
 /// the line of `initial:` carrying the Newton's residual.
 std::optional<Equilibrium> start_at_equilibrium(Diagram& d);
 
+/// The same at time t with `held` (signal offset, value) held besides the scene's own
+/// `initial.hold`, computed whether or not d.start is current: an FMU's start, its inputs held
+/// at the importer's values (fmi/fmu_model.cpp). Nothing for a scene without `initial:
+/// equilibrium`.
+std::optional<Equilibrium> start_at_equilibrium(Diagram& d, double t, const std::vector<std::pair<int, double>>& held);
+
 /// start_at_equilibrium(d), then run(d, options).
 RunResult run_from_initial(Diagram& d, const RunOptions& options = {});
 

@@ -7,12 +7,15 @@
 #include <Eigen/Dense>
 #include <cstdio>
 #include <ctime>
+#include <fstream>
+#include <sstream>
 #include <random>
 
 #include "engine/evaluation/evaluator.hpp"
 #include "engine/framework/diagram.hpp"
 #include "engine/linear/linearization.hpp"
 #include "engine/linear/signal_lookup.hpp"
+#include "engine/studies/initial_equilibrium.hpp"
 #include "tests/fmi/fmu_fixture.hpp"
 
 namespace dydp::test {
@@ -332,6 +335,58 @@ TEST_P(ModelExchange, DirectionalAndAdjointDerivativesAreTheTangents) {
   std::printf("[measure] %s at t = %g s, %zu x %zu: directional derivatives against the native linearisation %.2g, "
               "against central differences %.2g (relative to each row), <w, Jv> - <J^T w, v> %.2g (relative)\n",
               c.name.c_str(), t, nu, nk, e_native, e_fd, e_dot);
+  f.fmi3FreeInstance(inst);
+}
+
+TEST(ModelExchangeEquilibrium, ASceneThatStartsAtItsEquilibriumStartsThereWithTheImportersInputs) {
+  // The CDC damper's FMU with its rig scene starting at `initial: equilibrium`: the hydraulics'
+  // steady state at the stroke and stroke rate the importer sets before initialisation ends.
+  std::ifstream in(kDamperRig);
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string rig = (FmuFolder::path() / "cdc_damper_rig_at_rest.yaml").string();
+  std::ofstream(rig) << text.str() << "initial: equilibrium\n";
+  const std::string description = (FmuFolder::path() / "cdc_damper_at_rest.yml").string();
+  std::ofstream(description) << "fmu: cdc_damper_at_rest\nscene: cdc_damper_rig_at_rest.yaml\n"
+                                "inputs: [stroke.y, stroke_rate.y]\noutputs: [damper.force]\n"
+                                "parameters: [valve_current, pipe_length]\n";
+  auto fmu = load_fmu(description, "cdc_damper_at_rest", "equilibrium");
+  const Fmi3Functions& f = fmu->f();
+  fmi3Instance inst = fmu->instantiate_me();
+  ASSERT_NE(inst, nullptr) << fmu->last_error();
+  ASSERT_EQ(f.fmi3EnterInitializationMode(inst, false, 0.0, 0.0, true, 1.0), fmi3OK) << fmu->last_error();
+  const std::vector<fmi3ValueReference> inputs = fmu->description().of("input");
+  ASSERT_EQ(inputs.size(), 2u);
+  const std::vector<double> u = {0.004, 0.1};  // [m], [m/s]
+  ASSERT_EQ(f.fmi3SetFloat64(inst, inputs.data(), u.size(), u.data(), u.size()), fmi3OK) << fmu->last_error();
+  ASSERT_EQ(f.fmi3ExitInitializationMode(inst), fmi3OK) << fmu->last_error();
+  size_t n = 0;
+  ASSERT_EQ(f.fmi3GetNumberOfContinuousStates(inst, &n), fmi3OK);
+  VectorXd x(n), xdot(n), nominal(n);
+  ASSERT_EQ(f.fmi3GetContinuousStates(inst, x.data(), n), fmi3OK);
+  ASSERT_EQ(f.fmi3GetContinuousStateDerivatives(inst, xdot.data(), n), fmi3OK);
+  ASSERT_EQ(f.fmi3GetNominalsOfContinuousStates(inst, nominal.data(), n), fmi3OK);
+
+  // dydp's own equilibrium with the same inputs held, and the one at the scene's own inputs.
+  engine::Diagram d = engine::load_scene(rig);
+  std::vector<std::pair<int, double>> held;
+  for (size_t j = 0; j < inputs.size(); ++j)
+    held.emplace_back(engine::signal_offsets(d, fmu->description().variables[inputs[j]].name, "test").at(0), u[j]);
+  ASSERT_TRUE(engine::start_at_equilibrium(d, 0.0, held).has_value());
+  const std::vector<double> at_inputs = d.start.x;
+  ASSERT_TRUE(engine::start_at_equilibrium(d, 0.0, {}).has_value());
+  const std::vector<double> at_scene_inputs = d.start.x;
+  ASSERT_EQ(at_inputs.size() + static_cast<size_t>(d.num_quadratures), n);
+  double moved = 0.0, rest = 0.0;
+  for (int i = 0; i < d.num_states; ++i) {
+    EXPECT_NEAR(x[i], at_inputs[i], 1e-12 * nominal[i]) << "state " << i;
+    moved = std::max(moved, std::fabs(at_inputs[i] - at_scene_inputs[i]) / nominal[i]);
+    rest = std::max(rest, std::fabs(xdot[i]) / nominal[i]);
+  }
+  EXPECT_GT(moved, 1e-3);  // the importer's inputs, not the scene's, set the equilibrium
+  EXPECT_LT(rest, 1e-8);   // nominal units per second: the FMU's state derivatives vanish there
+  std::printf("equilibrium: %d states, %.3g nominal units from the one at the scene's inputs, largest rate %.2g /s\n",
+              d.num_states, moved, rest);
   f.fmi3FreeInstance(inst);
 }
 
