@@ -10,6 +10,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "engine/analysis/cvodes_problem.hpp"
+#include "engine/analysis/tolerances.hpp"
 #include "engine/framework/block.hpp"
 #include "engine/framework/errors.hpp"
 
@@ -54,6 +56,20 @@ int jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix jac, void* user, N_V
   });
 }
 
+int sens_rhs(int ns, sunrealtype t, N_Vector y, N_Vector, N_Vector* ys, N_Vector* ysdot, void* user, N_Vector,
+             N_Vector) {
+  auto& s = *static_cast<CvodesStepper*>(user);
+  return guarded(s, t, [&] {
+    const int n = s.model.num_states();
+    s.model.move_to(t, N_VGetArrayPointer(y));
+    engine::cvodes::gather(ys, n, ns, s.s_buffer);
+    s.sdot_buffer.resize(s.s_buffer.size());
+    s.model.sensitivity_derivatives(s.s_buffer.data(), s.sdot_buffer.data());
+    engine::cvodes::scatter(s.sdot_buffer, n, ns, ysdot);
+    return 0;
+  });
+}
+
 void silent(int, const char*, const char*, char*, void*) {}
 
 void check(int flag, const char* call) {
@@ -85,10 +101,23 @@ CvodesStepper::CvodesStepper(FmuModel& m, const StepperSettings& settings) : mod
   check(CVodeSetJacFn(cvode_, jacobian), "CVodeSetJacFn");
   check(CVodeSetMaxNumSteps(cvode_, settings_.max_steps), "CVodeSetMaxNumSteps");
   if (settings_.max_order > 0) check(CVodeSetMaxOrd(cvode_, settings_.max_order), "CVodeSetMaxOrd");
+  ns_ = model.num_states() > 0 ? model.num_sensitivities() : 0;
+  if (ns_ > 0) {
+    // Forward sensitivities by the simultaneous corrector, their right-hand side the tangent pass
+    // (as dydp's own runs, engine/analysis/cvodes_solver.cpp); in the error test or not as the
+    // scene's solver says. Their values and tolerances are set at each (re)start.
+    N_Vector* ys = N_VCloneVectorArray(ns_, vec(y_));
+    sens_ = ys;
+    for (int dir = 0; dir < ns_; ++dir) N_VConst(0.0, ys[dir]);
+    check(CVodeSensInit(cvode_, ns_, CV_SIMULTANEOUS, sens_rhs, ys), "CVodeSensInit");
+    check(CVodeSetSensErrCon(cvode_, model.diagram().solver.sens_error_test), "CVodeSetSensErrCon");
+  }
 }
 
 CvodesStepper::~CvodesStepper() {
   CVodeFree(&cvode_);
+  if (sens_) N_VDestroyVectorArray(static_cast<N_Vector*>(sens_), ns_);
+  if (sens_atol_) N_VDestroyVectorArray(static_cast<N_Vector*>(sens_atol_), ns_);
   SUNLinSolFree(static_cast<SUNLinearSolver>(solver_));
   SUNMatDestroy(static_cast<SUNMatrix>(matrix_));
   N_VDestroy(vec(y_));
@@ -100,6 +129,28 @@ CvodesStepper::~CvodesStepper() {
 void CvodesStepper::restart() {
   std::copy(model.states().begin(), model.states().end(), N_VGetArrayPointer(vec(y_)));
   check(CVodeReInit(cvode_, model.time(), vec(y_)), "CVodeReInit");
+  if (ns_ == 0) return;
+  // The sensitivities go on from the model's (the start's, or as the last step left them: an
+  // importer's new states or parameters do not change them), held to dydp's tolerances for the
+  // parameters' present values (engine/analysis/tolerances.hpp).
+  N_Vector* ys = static_cast<N_Vector*>(sens_);
+  const int n = model.num_states();
+  engine::cvodes::scatter(model.sensitivities(), n, ns_, ys);
+  check(CVodeSensReInit(cvode_, CV_SIMULTANEOUS, ys), "CVodeSensReInit");
+  const engine::Diagram& d = model.diagram();
+  const engine::AbsoluteTolerances atols = engine::absolute_tolerances(d, settings_.atol, ns_);
+  if (sens_atol_) N_VDestroyVectorArray(static_cast<N_Vector*>(sens_atol_), ns_);
+  sens_atol_ = engine::cvodes::sensitivity_tolerances(atols, d.num_states, d.num_quadratures, ns_, settings_.atol, vec(y_));
+  check(CVodeSensSVtolerances(cvode_, settings_.rtol, static_cast<N_Vector*>(sens_atol_)), "CVodeSensSVtolerances");
+}
+
+void CvodesStepper::take_sensitivities() {
+  if (ns_ == 0) return;
+  sunrealtype t = model.time();
+  N_Vector* ys = static_cast<N_Vector*>(sens_);
+  if (CVodeGetSens(cvode_, &t, ys) < 0) return;
+  engine::cvodes::gather(ys, model.num_states(), ns_, s_buffer);
+  model.move_sensitivities(s_buffer.data());
 }
 
 long CvodesStepper::steps() const {
@@ -128,12 +179,14 @@ void CvodesStepper::advance(double t_end) {
       const std::string why = failure.empty() ? "CVODES failed (flag " + std::to_string(flag) + ")" : failure;
       const double at = failure.empty() ? reached : failure_time;
       model.move_to(reached, N_VGetArrayPointer(vec(y_)));
+      take_sensitivities();
       seen_changes_ = -1;
       if (!failure.empty() && failure.find(": ") != std::string::npos)
         throw engine::domain_failure(at, engine::OutOfDomain{why});
       throw engine::SolverError(at, "", why);
     }
     model.move_to(target, N_VGetArrayPointer(vec(y_)));
+    take_sensitivities();
     if (target == t_break) {  // a breakpoint: the right-hand side may jump, BDF starts again
       model.set_segment_start(target);
       seen_changes_ = -1;

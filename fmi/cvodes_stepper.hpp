@@ -2,10 +2,14 @@
 // its Newton matrix the exact d(xdot)/dx from the blocks' tangents, the absolute tolerance
 // scaled by each state's nominal magnitude (as dydp's own runs do, docs/engine.md). It stops
 // at every breakpoint of the blocks (a new segment there) and restarts when the importer
-// changed the inputs, the states or the parameters between two communication points.
+// changed the inputs, the states or the parameters between two communication points. With the
+// description's sensitivity directions, CVODES' forward sensitivities along them (simultaneous
+// corrector, right-hand side from the blocks' tangents, tolerances and error test as dydp's own
+// runs), carried over breakpoints and restarts.
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "fmi/fmu_model.hpp"
 
@@ -37,6 +41,7 @@ class CvodesStepper {
 
  private:
   void restart();
+  void take_sensitivities();  ///< CVODES' sensitivities at its last step's end into the model
   StepperSettings settings_;
   void* context_ = nullptr;
   void* cvode_ = nullptr;
@@ -44,6 +49,14 @@ class CvodesStepper {
   void* atol_ = nullptr;
   void* matrix_ = nullptr;
   void* solver_ = nullptr;
+  void* sens_ = nullptr;      ///< the sensitivities' N_Vector array (ns_ vectors), or null
+  void* sens_atol_ = nullptr;  ///< their absolute tolerances
+  int ns_ = 0;
+
+ public:
+  // The sensitivity callback's buffers: the sensitivities and their derivatives, direction d
+  // at [d * num_states].
+  std::vector<double> s_buffer, sdot_buffer;
   long seen_changes_ = -1;
   long steps_before_ = 0;
 };

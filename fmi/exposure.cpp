@@ -54,12 +54,14 @@ Exposure read_exposure(const std::string& path) {
     e.scene_file = path;
     return e;
   }
-  static const std::set<std::string> keys = {"fmu", "description", "scene", "inputs", "outputs", "parameters"};
+  static const std::set<std::string> keys = {"fmu", "description", "scene", "inputs", "outputs", "parameters",
+                                           "sensitivities"};
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();
     if (!keys.count(key))
       throw InputError(path, line_of(kv.first), key,
-                       "unknown key of an FMU description (fmu, description, scene, inputs, outputs, parameters)");
+                       "unknown key of an FMU description (fmu, description, scene, inputs, outputs, parameters, "
+                       "sensitivities)");
   }
   if (!root["fmu"].IsScalar() || root["fmu"].Scalar().empty())
     throw InputError(path, line_of(root["fmu"]), "fmu", "expected the FMU's name");
@@ -72,11 +74,17 @@ Exposure read_exposure(const std::string& path) {
   if (root["inputs"]) e.inputs = read_list(root, "inputs", path);
   if (root["outputs"]) e.outputs = read_list(root, "outputs", path), e.default_outputs = false;
   if (root["parameters"]) e.parameters = read_list(root, "parameters", path), e.default_parameters = false;
+  if (root["sensitivities"]) {
+    e.sensitivities = read_list(root, "sensitivities", path);
+    for (const auto& kv : root)
+      if (kv.first.as<std::string>() == "sensitivities") e.sensitivities_line = line_of(kv.first);
+  }
   return e;
 }
 
 std::string exposure_text(const Exposure& e, const std::string& scene_name, const std::vector<std::string>& inputs,
-                          const std::vector<std::string>& outputs, const std::vector<std::string>& parameters) {
+                          const std::vector<std::string>& outputs, const std::vector<std::string>& parameters,
+                          const std::vector<std::string>& sensitivities) {
   YAML::Emitter out;
   out << YAML::BeginMap << YAML::Key << "fmu" << YAML::Value << e.model_name;
   if (!e.description.empty()) out << YAML::Key << "description" << YAML::Value << e.description;
@@ -84,6 +92,7 @@ std::string exposure_text(const Exposure& e, const std::string& scene_name, cons
   out << YAML::Key << "inputs" << YAML::Value << YAML::Flow << inputs;
   out << YAML::Key << "outputs" << YAML::Value << YAML::Flow << outputs;
   out << YAML::Key << "parameters" << YAML::Value << YAML::Flow << parameters;
+  if (!sensitivities.empty()) out << YAML::Key << "sensitivities" << YAML::Value << YAML::Flow << sensitivities;
   out << YAML::EndMap;
   return std::string("# What this FMU exposes (written by dydp fmu; docs/fmi.md).\n") + out.c_str() + "\n";
 }

@@ -25,17 +25,21 @@ struct Exposure {
   std::vector<ExposedName> inputs;      ///< signals (BLOCK.PORT or BLOCK.PORT[i]) the importer sets
   std::vector<ExposedName> outputs;     ///< signals or objective block names
   std::vector<ExposedName> parameters;  ///< scene parameter names
+  /// Sensitivity directions (scene parameters or declared directions): each output gets its
+  /// derivative along each as an output of its own, in Co-Simulation only.
+  std::vector<ExposedName> sensitivities;
+  int sensitivities_line = 0;  ///< of `sensitivities:` (0: not written)
 };
 
 /// Reads `path`: a scene (top-level `scene:`) or an FMU description (top-level `fmu:`, with
-/// `scene:` a path relative to it, and optional `inputs:`, `outputs:`, `parameters:` lists,
-/// `description:`). Throws engine::InputError naming file, line and field.
+/// `scene:` a path relative to it, and optional `inputs:`, `outputs:`, `parameters:`,
+/// `sensitivities:` lists, `description:`). Throws engine::InputError naming file, line and field.
 Exposure read_exposure(const std::string& path);
 
 /// The description file of an exposure whose lists are written out (the FMU's
 /// resources/fmu.yaml): `scene_name` is the scene's path relative to it.
 std::string exposure_text(const Exposure& e, const std::string& scene_name,
                           const std::vector<std::string>& inputs, const std::vector<std::string>& outputs,
-                          const std::vector<std::string>& parameters);
+                          const std::vector<std::string>& parameters, const std::vector<std::string>& sensitivities);
 
 }  // namespace dydp::fmi

@@ -51,6 +51,8 @@ fmi3Instance instantiate(fmi3String name, fmi3String token, fmi3String resources
     if (!token || i->model->table().token != token)
       throw std::invalid_argument(std::string("instantiation token ") + (token ? token : "(null)") +
                                   " is not this FMU's " + i->model->table().token);
+    if (!co_simulation && i->model->num_sensitivities() > 0)
+      throw std::invalid_argument("this FMU's sensitivity outputs exist in Co-Simulation only (its integrator gives them)");
     const auto& solver = i->model->diagram().solver;
     i->settings.rtol = solver.rtol;
     i->settings.atol = solver.atol;

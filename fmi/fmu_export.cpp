@@ -48,6 +48,12 @@ ExportSummary export_fmu(const ExportOptions& o) {
   if (fs::path(o.out).extension() != ".fmu") throw InputError("--out", 0, "", o.out + ": expected NAME.fmu");
   if (!o.model_exchange && !o.co_simulation) throw InputError("--kind", 0, "", "neither Model Exchange nor Co-Simulation");
   const Exposure e = read_exposure(o.source);
+  // Sensitivity outputs come from the integrator inside the FMU (its states' sensitivities): in
+  // Model Exchange the importer's integrator owns the states, so there are none to give.
+  if (!e.sensitivities.empty() && o.model_exchange)
+    throw InputError(e.spec_file, e.sensitivities_line, "sensitivities",
+                     "sensitivity outputs exist in Co-Simulation only (the FMU integrates them with its states); "
+                     "export with --kind cs");
   engine::Diagram d = engine::load_scene(e.scene_file);
   const VariableTable t = build_variables(d, e);
 
@@ -103,17 +109,19 @@ ExportSummary export_fmu(const ExportOptions& o) {
     for (const ExposedName& n : e.outputs) outputs.push_back(n.name);
   }
   // The inputs as named (a whole port stays one entry) so the FMU builds the same table.
-  std::vector<std::string> input_names;
+  std::vector<std::string> input_names, sensitivity_names;
   for (const ExposedName& n : e.inputs) input_names.push_back(n.name);
+  for (const ExposedName& n : e.sensitivities) sensitivity_names.push_back(n.name);
   const std::string scene_rel =
       "model/" + fs::path(fs::absolute(e.scene_file).lexically_normal()).lexically_relative(root).generic_string();
-  entries.push_back({"resources/fmu.yaml", exposure_text(e, scene_rel, input_names, outputs, parameters), ""});
+  entries.push_back({"resources/fmu.yaml", exposure_text(e, scene_rel, input_names, outputs, parameters, sensitivity_names), ""});
   write_archive(o.out, entries);
 
   for (const Variable& v : t.variables) {
     summary.parameters += v.role == Role::parameter;
     summary.inputs += v.role == Role::input;
-    summary.outputs += v.role == Role::output_signal || v.role == Role::output_objective;
+    summary.outputs += v.role == Role::output_signal || v.role == Role::output_objective ||
+                       v.role == Role::output_sensitivity;
   }
   summary.states = t.num_states();
   summary.event_indicators = static_cast<int>(t.breakpoints.size());

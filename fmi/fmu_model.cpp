@@ -22,6 +22,7 @@ FmuModel::FmuModel(const std::string& fmu_file) {
   for (const Variable& v : table_.variables)
     if (v.role == Role::input) inputs_[v.index] = v.start;
   x_.assign(num_states(), 0.0);
+  sens_.assign(static_cast<size_t>(num_states()) * num_sensitivities(), 0.0);
   stop_ = diagram_->time.stop;
   refresh();
   start(diagram_->time.start, diagram_->time.stop);
@@ -31,6 +32,7 @@ void FmuModel::refresh() {
   held_.clear();
   for (size_t j = 0; j < inputs_.size(); ++j) held_.emplace_back(table_.input_offsets[j], inputs_[j]);
   ev_->hold_signals(held_);  // also drops the evaluator's caches (parameters may have changed)
+  output_sens_valid_ = false;
   ++changes_;
 }
 
@@ -45,24 +47,84 @@ void FmuModel::start(double t0, double stop) {
   ev_->initial_state(t0, x0.data());
   std::fill(x_.begin(), x_.end(), 0.0);
   std::copy(x0.begin(), x0.begin() + diagram_->num_states, x_.begin());
+  // The sensitivities of that start: the blocks' initial states' tangents, or the equilibrium's
+  // dx/dp (Diagram::start); the integrals start at zero whatever the parameters.
+  std::fill(sens_.begin(), sens_.end(), 0.0);
+  const int nx = diagram_->num_states, n = num_states();
+  if (num_sensitivities() > 0 && nx > 0) {
+    std::vector<double> dx0(static_cast<size_t>(nx) * diagram_->sensitivities.size(), 0.0);
+    ev_->initial_state_tangent(t0, x0.data(), DirView{dx0.data(), nx});
+    for (int dir = 0; dir < num_sensitivities(); ++dir)
+      std::copy_n(dx0.data() + static_cast<size_t>(dir) * nx, nx, sens_.data() + static_cast<size_t>(dir) * n);
+  }
+  output_sens_valid_ = false;
   ++changes_;
 }
 
-void FmuModel::set_time(double t) { t_ = t; }
+void FmuModel::set_time(double t) {
+  t_ = t;
+  output_sens_valid_ = false;
+}
 
 void FmuModel::move_to(double t, const double* x) {
   t_ = t;
   std::copy(x, x + num_states(), x_.begin());
+  output_sens_valid_ = false;
+}
+
+void FmuModel::move_sensitivities(const double* s) {
+  std::copy(s, s + sens_.size(), sens_.begin());
+  output_sens_valid_ = false;
 }
 
 void FmuModel::set_segment_start(double t) {
   segment_start_ = t;
   ev_->set_segment_start(t);
+  output_sens_valid_ = false;
 }
 
 void FmuModel::set_states(const double* x) {
   std::copy(x, x + num_states(), x_.begin());
+  output_sens_valid_ = false;
   ++changes_;
+}
+
+void FmuModel::hold_input_tangents(int nd) {
+  ev_->set_signal_seeds(table_.input_offsets, std::vector<double>(inputs_.size() * nd, 0.0));
+}
+
+void FmuModel::sensitivity_derivatives(const double* s, double* sdot) {
+  const int nx = diagram_->num_states, nq = diagram_->num_quadratures, n = num_states(), ns = num_sensitivities();
+  std::fill(sdot, sdot + static_cast<size_t>(n) * ns, 0.0);
+  if (ns == 0 || n == 0) return;
+  // Both views step by the FMU's state vector: a direction's block states, then its integrals.
+  hold_input_tangents(ns);
+  ev_->tangents(t_, x_.data(), ns, ConstDirView{s, n}, true, DirView{nx ? sdot : nullptr, n},
+                DirView{nq ? sdot + nx : nullptr, n});
+  ev_->set_signal_seeds({}, {});
+}
+
+double FmuModel::sensitivity_value(const Variable& v) {
+  const Variable& out = table_.variables[v.index];
+  const int n = num_states();
+  const double* s = sens_.data() + static_cast<size_t>(v.direction) * n;
+  if (out.role == Role::output_objective) {  // from its integrals' sensitivities
+    const engine::Node& node = diagram_->nodes[out.index];
+    double dpsi = 0.0;
+    objective_value(out.index, s + diagram_->num_states + node.quad_offset, &dpsi);
+    return dpsi;
+  }
+  // Signals: one output tangent pass along the states' sensitivities for every output, kept
+  // until the time or the state moves.
+  if (!output_sens_valid_) {
+    const int ns = num_sensitivities();
+    hold_input_tangents(ns);
+    ev_->tangents(t_, x_.data(), ns, ConstDirView{sens_.data(), n}, true, DirView{}, DirView{});
+    ev_->set_signal_seeds({}, {});
+    output_sens_ = ev_->signal_tangents();
+    output_sens_valid_ = true;
+  }
+  return output_sens_[static_cast<size_t>(v.direction) * diagram_->num_signals + out.index];
 }
 
 void FmuModel::set_value(const Variable& v, double value) {
@@ -103,6 +165,7 @@ double FmuModel::value(const Variable& v) {
       return ev_->signals()[v.index];
     case Role::output_objective: return objective_value(v.index, nullptr, nullptr);
     case Role::event_indicator: return t_ - table_.breakpoints[v.index];
+    case Role::output_sensitivity: return sensitivity_value(v);
   }
   return std::numeric_limits<double>::quiet_NaN();
 }
@@ -129,7 +192,8 @@ void FmuModel::directional_derivative(const std::vector<const Variable*>& unknow
   const int nx = diagram_->num_states, nq = diagram_->num_quadratures;
   // The seeds of the known side: states (block states and integrals), inputs, parameters.
   std::vector<double> dx(std::max(nx, 1), 0.0), dq(std::max(nq, 1), 0.0), du(inputs_.size(), 0.0);
-  std::vector<double> dp(table_.differentiable.size(), 0.0);
+  const std::vector<int>& directions = diagram_->sensitivities;  // the differentiable knowns among them
+  std::vector<double> dp(directions.size(), 0.0);
   bool any_p = false;
   for (size_t j = 0; j < knowns.size(); ++j) {
     const Variable& k = *knowns[j];
@@ -138,10 +202,11 @@ void FmuModel::directional_derivative(const std::vector<const Variable*>& unknow
     } else if (k.role == Role::input) {
       du[k.index] += seed[j];
     } else if (k.role == Role::parameter) {
-      const auto it = std::find(table_.differentiable.begin(), table_.differentiable.end(), k.index);
-      if (it == table_.differentiable.end())
+      const auto it = std::find(directions.begin(), directions.end(), k.index);
+      if (std::find(table_.differentiable.begin(), table_.differentiable.end(), k.index) == table_.differentiable.end() ||
+          it == directions.end())
         throw std::invalid_argument(k.name + " drives a block parameter its block cannot differentiate");
-      dp[it - table_.differentiable.begin()] += seed[j];
+      dp[it - directions.begin()] += seed[j];
       any_p = true;
     } else {
       throw std::invalid_argument(k.name + " is not a known of a partial derivative (a state, an input or a parameter)");
@@ -149,10 +214,11 @@ void FmuModel::directional_derivative(const std::vector<const Variable*>& unknow
   }
   for (const Variable* u : unknowns)
     if (u->role != Role::derivative && u->role != Role::output_signal && u->role != Role::output_objective)
-      throw std::invalid_argument(u->name + " is not an unknown of a partial derivative (a derivative or an output)");
+      throw std::invalid_argument(u->name + " is not an unknown of a partial derivative (a derivative or an output" +
+                                  (u->role == Role::output_sensitivity ? "; a sensitivity's derivatives are not given)" : ")"));
 
   // One tangent pass along (dx, du); the parameters' columns from a pass with their seeds.
-  const int ns = static_cast<int>(table_.differentiable.size());
+  const int ns = static_cast<int>(directions.size());
   const int ld = diagram_->num_signals;
   std::vector<double> dxdot(std::max(nx, 1), 0.0), dqdot(std::max(nq, 1), 0.0);
   ev_->set_signal_seeds(table_.input_offsets, du);
@@ -217,19 +283,21 @@ void FmuModel::state_jacobian(double* jac) {
 }
 
 ModelSnapshot FmuModel::snapshot() const {
-  ModelSnapshot s{t_, segment_start_, x_, inputs_, {}};
+  ModelSnapshot s{t_, segment_start_, x_, inputs_, {}, sens_};
   for (const auto& p : diagram_->parameters) s.parameters.push_back(p.value);
   return s;
 }
 
 void FmuModel::restore(const ModelSnapshot& s) {
-  if (s.states.size() != x_.size() || s.inputs.size() != inputs_.size() || s.parameters.size() != diagram_->parameters.size())
+  if (s.states.size() != x_.size() || s.inputs.size() != inputs_.size() ||
+      s.parameters.size() != diagram_->parameters.size() || s.sensitivities.size() != sens_.size())
     throw std::invalid_argument("an FMU state of another model");
   for (size_t i = 0; i < s.parameters.size(); ++i)
     if (diagram_->parameters[i].value != s.parameters[i]) diagram_->set_parameter(static_cast<int>(i), s.parameters[i], false);
   t_ = s.time;
   x_ = s.states;
   inputs_ = s.inputs;
+  sens_ = s.sensitivities;
   set_segment_start(s.segment_start);
   refresh();
 }

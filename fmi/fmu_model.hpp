@@ -21,6 +21,7 @@ struct ModelSnapshot {
   double time = 0.0;
   double segment_start = 0.0;
   std::vector<double> states, inputs, parameters;
+  std::vector<double> sensitivities;  ///< the states' sensitivities, when the FMU has directions
 };
 
 class FmuModel {
@@ -32,9 +33,12 @@ class FmuModel {
   const VariableTable& table() const { return table_; }
   const engine::Diagram& diagram() const { return *diagram_; }
   int num_states() const { return table_.num_states(); }
+  /// The description's sensitivity directions (Co-Simulation): the first of the diagram's.
+  int num_sensitivities() const { return static_cast<int>(table_.sensitivities.size()); }
   double stop_time() const { return stop_; }
 
-  /// Time span and the start state from the blocks' initial states at t0 (parameters as set).
+  /// Time span and the start state from the blocks' initial states at t0 (parameters as set),
+  /// or the equilibrium of `initial: equilibrium`; with directions, their sensitivities there.
   void start(double t0, double stop);
   void set_time(double t);
   double time() const { return t_; }
@@ -42,6 +46,14 @@ class FmuModel {
   void set_segment_start(double t);
   void set_states(const double* x);
   const std::vector<double>& states() const { return x_; }
+  /// d(FMU state)/d(direction) for the directions, direction d at [d * num_states()]: set at the
+  /// start and moved by the integrator; setting the states or a parameter leaves them as they were.
+  const std::vector<double>& sensitivities() const { return sens_; }
+  /// The integrator's move of the sensitivities (with move_to).
+  void move_sensitivities(const double* s);
+  /// d(sensitivities)/dt at (t, x) for the sensitivities s (layout as sensitivities()): the
+  /// tangent pass along the states' sensitivities and the directions' parameter seeds.
+  void sensitivity_derivatives(const double* s, double* sdot);
 
   /// Sets a parameter or an input; throws engine::InputError out of its bounds.
   void set_value(const Variable& v, double value);
@@ -76,13 +88,21 @@ class FmuModel {
  private:
   void refresh();  ///< after inputs or parameters changed: the evaluator's caches go
   double objective_value(int node, const double* dq, double* dpsi);
+  double sensitivity_value(const Variable& v);
+
+  /// The held inputs' tangents: zero in each of nd directions (the importer's values do not
+  /// move with a parameter) for the tangent passes of the sensitivities.
+  void hold_input_tangents(int nd);
 
   std::unique_ptr<engine::Diagram> diagram_;
   VariableTable table_;
   std::unique_ptr<engine::Evaluator> ev_;
   long changes_ = 0;
   double t_ = 0.0, segment_start_ = 0.0, stop_ = 0.0;
-  std::vector<double> x_, inputs_;
+  std::vector<double> x_, inputs_, sens_;
+  /// The signals' tangents along the sensitivities at (t_, x_): valid until either moves.
+  std::vector<double> output_sens_;
+  bool output_sens_valid_ = false;
   std::vector<std::pair<int, double>> held_;
 };
 

@@ -1,6 +1,7 @@
 // An FMU state as bytes (fmi3SerializeFMUState, fmi3DeserializeFMUState): a header, the
-// instantiation token of the model it belongs to, then time, segment start, states, inputs and
-// parameters, so that bytes of another model or damaged bytes are refused.
+// instantiation token of the model it belongs to, then time, segment start, states, inputs,
+// parameters and the states' sensitivities (when the FMU has directions), so that bytes of
+// another model or damaged bytes are refused.
 #pragma once
 
 #include <string>

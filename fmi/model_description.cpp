@@ -31,9 +31,14 @@ const char* causality(Role r) {
     case Role::parameter: return "parameter";
     case Role::input: return "input";
     case Role::output_signal:
-    case Role::output_objective: return "output";
+    case Role::output_objective:
+    case Role::output_sensitivity: return "output";
     default: return "local";
   }
+}
+
+bool is_output(Role r) {
+  return r == Role::output_signal || r == Role::output_objective || r == Role::output_sensitivity;
 }
 
 /// The attributes both interface elements share.
@@ -95,8 +100,7 @@ std::string model_description_xml(const engine::Diagram& d, const VariableTable&
     if (!v.description.empty()) x << " description=\"" << xml_escape(v.description) << "\"";
     x << " causality=\"" << causality(v.role) << "\"";
     x << " variability=\"" << (v.role == Role::parameter ? "tunable" : "continuous") << "\"";
-    if (v.role == Role::state || v.role == Role::derivative || v.role == Role::output_signal ||
-        v.role == Role::output_objective || v.role == Role::event_indicator)
+    if (v.role == Role::state || v.role == Role::derivative || is_output(v.role) || v.role == Role::event_indicator)
       x << " initial=\"calculated\"";
     if (v.role == Role::parameter) x << " initial=\"exact\"";
     if (!v.unit.empty()) x << " unit=\"" << xml_escape(v.unit) << "\"";
@@ -110,15 +114,14 @@ std::string model_description_xml(const engine::Diagram& d, const VariableTable&
   x << "  </ModelVariables>\n";
   x << "  <ModelStructure>\n";
   for (const Variable& v : t.variables)
-    if (v.role == Role::output_signal || v.role == Role::output_objective)
+    if (is_output(v.role))
       x << "    <Output valueReference=\"" << v.value_reference << "\" dependencies=\"" << list(v.dependencies) << "\"/>\n";
   for (const Variable& v : t.variables)
     if (v.role == Role::derivative)
       x << "    <ContinuousStateDerivative valueReference=\"" << v.value_reference << "\" dependencies=\""
         << list(v.dependencies) << "\"/>\n";
   for (const Variable& v : t.variables)
-    if (v.role == Role::output_signal || v.role == Role::output_objective || v.role == Role::state ||
-        v.role == Role::derivative)
+    if (is_output(v.role) || v.role == Role::state || v.role == Role::derivative)
       x << "    <InitialUnknown valueReference=\"" << v.value_reference << "\"/>\n";
   for (const Variable& v : t.variables)
     if (v.role == Role::event_indicator)

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <set>
 
+#include "engine/analysis/run_result.hpp"
 #include "engine/evaluation/evaluator.hpp"
 #include "engine/framework/errors.hpp"
 #include "engine/linear/linearization.hpp"
@@ -104,7 +105,34 @@ class TableBuilder {
       if (std::find(differentiable.begin(), differentiable.end(), i) != differentiable.end())
         t_.differentiable.push_back(i);
     }
-    d_.set_sensitivities(t_.differentiable);
+    add_sensitivity_directions(differentiable);
+  }
+
+  // The description's sensitivity directions (scene parameters or declared directions, each one
+  // its blocks can differentiate), then the differentiable knowns: the diagram's directions.
+  void add_sensitivity_directions(const std::vector<int>& differentiable) {
+    for (const ExposedName& s : e_.sensitivities) {
+      const int i = d_.find_parameter(s.name);
+      if (i < 0) {
+        std::string names;
+        for (const auto& sp : d_.parameters) names += (names.empty() ? "" : ", ") + sp.name;
+        throw InputError(e_.spec_file, s.line, "sensitivities",
+                         "no scene parameter or direction " + s.name + " (the scene's: " +
+                             (names.empty() ? "none" : names) + ")");
+      }
+      if (std::find(differentiable.begin(), differentiable.end(), i) == differentiable.end()) {
+        try {
+          engine::check_differentiable(d_.nodes, d_, {i});
+        } catch (const InputError& error) {
+          rethrow_at(e_, s.line, "sensitivities", error);
+        }
+      }
+      t_.sensitivities.push_back(i);
+    }
+    std::vector<int> directions = t_.sensitivities;
+    for (int i : t_.differentiable)
+      if (std::find(directions.begin(), directions.end(), i) == directions.end()) directions.push_back(i);
+    d_.set_sensitivities(directions);
   }
 
   // The exposed inputs, each starting at the scene's value of its signal.
@@ -246,9 +274,30 @@ class TableBuilder {
         for (int offset : offsets) add_signal_output(offset);
       }
     }
+    add_sensitivity_outputs();
     for (const Variable& v : t_.variables)
       if (!output_names.insert(v.name).second)
         throw InputError(e_.spec_file, 0, "outputs", "two variables of the FMU are named " + v.name);
+  }
+
+  // d(OUTPUT)/d(NAME) for each output and each sensitivity direction (the names of dydp's
+  // signals.csv and objectives.json), depending on what its output depends on.
+  void add_sensitivity_outputs() {
+    if (t_.sensitivities.empty()) return;
+    const size_t outputs = t_.variables.size();
+    for (size_t o = 0; o < outputs; ++o) {
+      const Variable out = t_.variables[o];
+      if (out.role != Role::output_signal && out.role != Role::output_objective) continue;
+      for (size_t k = 0; k < t_.sensitivities.size(); ++k) {
+        const engine::SceneParameter& p = d_.parameters[t_.sensitivities[k]];
+        Variable v = variable("d(" + out.name + ")/d(" + p.name + ")", Role::output_sensitivity,
+                              static_cast<int>(out.value_reference), engine::unit_per(out.unit, p.unit),
+                              "sensitivity of " + out.name + " to " + p.name + " (integrated with the states)");
+        v.direction = static_cast<int>(k);
+        v.dependencies = out.dependencies;
+        add(v);
+      }
+    }
   }
 
   // One event indicator per breakpoint.

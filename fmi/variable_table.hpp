@@ -16,7 +16,10 @@
 
 namespace dydp::fmi {
 
-enum class Role { time, parameter, input, state, derivative, output_signal, output_objective, event_indicator };
+enum class Role {
+  time, parameter, input, state, derivative, output_signal, output_objective, event_indicator,
+  output_sensitivity  ///< d(output)/d(direction), Co-Simulation only
+};
 
 struct Variable {
   std::string name;
@@ -24,8 +27,11 @@ struct Variable {
   Role role = Role::time;
   /// parameter: scene parameter index; input: index into the inputs; state, derivative: index
   /// into the FMU's state vector; output_signal: signal offset; output_objective: node index;
-  /// event_indicator: index of its breakpoint.
+  /// event_indicator: index of its breakpoint; output_sensitivity: value reference of its output.
   int index = 0;
+  /// output_sensitivity: its direction, an index into VariableTable::sensitivities (and into
+  /// the diagram's sensitivities, which begin with them).
+  int direction = -1;
   std::string unit;
   std::string description;
   bool has_start = false;
@@ -44,6 +50,9 @@ struct VariableTable {
   /// The exposed parameters the blocks can differentiate: the parameter knowns of the
   /// directional derivatives, and the diagram's sensitivity directions in the FMU.
   std::vector<int> differentiable;
+  /// The description's `sensitivities:` (scene parameter indices): the first directions of the
+  /// diagram's sensitivities, the differentiable knowns not among them after.
+  std::vector<int> sensitivities;
   int num_block_states = 0;          ///< the diagram's states
   int num_quadratures = 0;           ///< then the objectives' integrals
   std::vector<double> nominals;      ///< per FMU state

@@ -134,6 +134,16 @@ N_Vector state_tolerances(const Problem& P, const AbsoluteTolerances& atols, dou
   return v;
 }
 
+N_Vector* sensitivity_tolerances(const AbsoluteTolerances& atols, int nx, int nq, int ns, double atol, N_Vector like) {
+  N_Vector* v = N_VCloneVectorArray(ns, like);
+  for (int dir = 0; dir < ns; ++dir) {
+    N_VConst(atol, v[dir]);
+    std::copy_n(atols.sensitivities.data() + static_cast<size_t>(dir) * nx, nx, NV_DATA_S(v[dir]));
+    std::copy_n(atols.quadrature_sensitivities.data() + static_cast<size_t>(dir) * nq, nq, NV_DATA_S(v[dir]) + nx);
+  }
+  return v;
+}
+
 void set_up_forward(Problem& P, void* mem, SUNContext ctx, double t, N_Vector y, N_Vector atol, ForwardSolvers& s) {
   const SolverSpec& solver = P.d.solver;
   check_call(P, CVodeSetErrHandlerFn(mem, error_handler, &P), "CVodeSetErrHandlerFn", t);

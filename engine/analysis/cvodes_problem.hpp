@@ -119,6 +119,12 @@ void check_call(const Problem& P, int flag, const char* call, double t);
 /// vector like `like` for the caller to destroy.
 N_Vector state_tolerances(const Problem& P, const AbsoluteTolerances& atols, double atol, N_Vector like);
 
+/// The absolute tolerances of the sensitivities of CVODES' vector [x; q] in ns directions, one
+/// vector per direction: atols' sensitivities and quadrature sensitivities (`atol` for the
+/// placeholder state of a stateless diagram), a new array like `like` for the caller to destroy
+/// (N_VDestroyVectorArray). Also the FMU's integrator's (fmi/cvodes_stepper.cpp).
+N_Vector* sensitivity_tolerances(const AbsoluteTolerances& atols, int nx, int nq, int ns, double atol, N_Vector like);
+
 /// What a forward CVODES problem owns besides its memory (null where unused); an owner frees its
 /// CVODES memory before these (its destructor's body runs before its members').
 struct ForwardSolvers {

@@ -122,13 +122,7 @@ class CvodesRun {
     }
     // Sensitivity tolerances: the states' ones over the parameter's value (the pbar of CVODES'
     // guide), so dx/dk for a stiffness of 1e5 N/m is held to the same relative accuracy as dx/dm.
-    N_Vector* atol_sens = N_VCloneVectorArray(ns_, S_.y);
-    for (int dir = 0; dir < ns_; ++dir) {
-      N_VConst(d_.solver.atol, atol_sens[dir]);  // the placeholder state of a stateless diagram
-      std::copy_n(atols_.sensitivities.data() + static_cast<size_t>(dir) * nx_, nx_, NV_DATA_S(atol_sens[dir]));
-      std::copy_n(atols_.quadrature_sensitivities.data() + static_cast<size_t>(dir) * nq_, nq_,
-                  NV_DATA_S(atol_sens[dir]) + nx_);
-    }
+    N_Vector* atol_sens = sensitivity_tolerances(atols_, nx_, nq_, ns_, d_.solver.atol, S_.y);
     const int ssv_flag = CVodeSensSVtolerances(S_.mem, d_.solver.rtol, atol_sens);
     N_VDestroyVectorArray(atol_sens, ns_);
     check(ssv_flag, "CVodeSensSVtolerances");
