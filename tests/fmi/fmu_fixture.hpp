@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <numbers>
 #include <string>
@@ -36,17 +37,37 @@ class FmuFolder : public ::testing::Environment {
   void TearDown() override { std::filesystem::remove_all(path()); }
 };
 
-/// The FMU of `source` (exported on first use) unpacked and loaded, one copy per `tag`.
-inline std::unique_ptr<Fmu> load_fmu(const std::string& source, const std::string& name, const std::string& tag) {
+/// The FMU of `source` (exported on first use, both kinds or Co-Simulation only) unpacked and
+/// loaded, one copy per `tag`.
+inline std::unique_ptr<Fmu> load_fmu(const std::string& source, const std::string& name, const std::string& tag,
+                                     bool cs_only = false) {
   namespace fs = std::filesystem;
   const fs::path archive = FmuFolder::path() / (name + ".fmu");
   if (!fs::exists(archive)) {
     fmi::ExportOptions o;
     o.source = source;
     o.out = archive.string();
+    o.model_exchange = !cs_only;
     fmi::export_fmu(o);
   }
   return std::make_unique<Fmu>(archive.string(), (FmuFolder::path() / (name + "_" + tag)).string());
+}
+
+/// A copy of the CDC damper's description (scenarios/fmu/cdc_damper.yml) in the test folder with
+/// `sensitivities: [valve_current, pipe_length]`; without_inputs, the rig's sources drive the
+/// damper inside the FMU (as in the native run of the rig scene). Returns its path.
+inline std::string damper_sensitivity_description(bool without_inputs) {
+  const std::filesystem::path p =
+      FmuFolder::path() / (without_inputs ? "cdc_damper_sens_rig.yml" : "cdc_damper_sens.yml");
+  std::ofstream out(p);
+  out << "fmu: " << p.stem().string() << "\n"
+      << "description: CDC damper with the sensitivities to its valve current and pipe length.\n"
+      << "scene: " << std::string(DYDP_SOURCE_DIR) << "/scenarios/fmu/cdc_damper_rig.yaml\n"
+      << (without_inputs ? "" : "inputs: [stroke.y, stroke_rate.y]\n")
+      << "outputs: [damper.force, damper.p_rebound, damper.p_compression, damper.power]\n"
+      << "parameters: [valve_current, pipe_length]\n"
+      << "sensitivities: [valve_current, pipe_length]\n";
+  return p.string();
 }
 
 /// The sine sources of scenarios/fmu/cdc_damper_rig.yaml, as source.sine computes them.
