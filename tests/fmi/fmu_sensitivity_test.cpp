@@ -2,9 +2,9 @@
 // CDC damper's d(output)/d(valve_current) and d(output)/d(pipe_length) over a run against the
 // native run's sensitivities (engine::run with the same directions), both measured against a
 // converged native reference (from the blocks' initial states and from `initial: equilibrium`),
-// and against central differences of the FMU's own outputs; the
-// quarter car's objectives' sensitivities against objectives.json's; the refusal of Model
-// Exchange; the sensitivities through an FMU state.
+// and against central differences of the FMU's own outputs; the quarter car's objectives'
+// sensitivities against objectives.json's; the refusal of Model Exchange; the sensitivities
+// through an FMU state.
 #include <gtest/gtest.h>
 
 #include <cstdio>
