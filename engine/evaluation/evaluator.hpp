@@ -36,7 +36,8 @@ class Evaluator {
   void quadratures(double t, const double* x, double* qdot);
 
   /// Tangent pass for nd directions: state seeds dx (ld = num_states, null data: zero) and, when
-  /// with_params, the sensitivity parameter seeds (then nd must be num_directions()). Fills the
+  /// with_params, the parameter seeds of the first nd sensitivity directions (nd at most
+  /// num_directions(): an FMU's stepper carries only the directions it outputs). Fills the
   /// signal tangents and, where given, dxdot (ld = num_states) and dqdot (ld = num_quadratures).
   void tangents(double t, const double* x, int nd, ConstDirView dx, bool with_params,
                 DirView dxdot, DirView dqdot);
