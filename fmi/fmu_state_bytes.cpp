@@ -39,7 +39,7 @@ ModelSnapshot deserialise(const std::string& token, const ModelSnapshot& now, co
   size_t at = 0;
   auto take = [&](void* p, size_t n) {
     if (size - at < n) throw std::invalid_argument("serialized FMU state too short");
-    std::memcpy(p, data + at, n);
+    if (n) std::memcpy(p, data + at, n);  // an empty vector's data() may be null
     at += n;
   };
   char magic[8];
