@@ -18,6 +18,24 @@
 namespace dydp::gui {
 
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
+  QTabWidget* tabs = set_up_docks();
+
+  // Actions.
+  set_up_menus();
+
+  // Where the canvas is: the scene, or the subsystem instances opened; each entry goes back there.
+  set_up_level_toolbar();
+
+  status_label_ = new QLabel;
+  statusBar()->addWidget(status_label_, 1);
+
+  connect_panels(tabs);
+  resize(1500, 950);
+  update_title();
+}
+
+// The canvas and the docks around it (blocks, properties, results); returns the properties tabs.
+QTabWidget* MainWindow::set_up_docks() {
   canvas_ = new Canvas(&controller_);
   setCentralWidget(canvas_);
 
@@ -53,13 +71,25 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   results_dock->setObjectName("results");
   results_dock->setWidget(bottom_tabs_);
   addDockWidget(Qt::BottomDockWidgetArea, results_dock);
+  return tabs;
+}
 
-  // Actions.
+// The File, Edit, View and Run menus and the main toolbar, in that order.
+void MainWindow::set_up_menus() {
   auto* file = menuBar()->addMenu(tr("&File"));
   auto* edit = menuBar()->addMenu(tr("&Edit"));
   auto* run_menu = menuBar()->addMenu(tr("&Run"));
   auto* tools = addToolBar(tr("Main"));
   tools->setObjectName("main_toolbar");
+  const QList<QAction*> file_actions = add_file_actions(file);
+  const QList<QAction*> edit_actions = add_edit_actions(edit);
+  add_view_actions(menuBar()->addMenu(tr("&View")));
+  add_run_actions(run_menu);
+  fill_main_toolbar(tools, file_actions, edit_actions);
+}
+
+// File: new, open, save, save as, quit; returns new, open and save for the toolbar.
+QList<QAction*> MainWindow::add_file_actions(QMenu* file) {
   auto* act_new = file->addAction(tr("&New"), QKeySequence::New, this, [this] {
     if (maybe_save()) controller_.new_scene();
   });
@@ -79,6 +109,11 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   });
   file->addSeparator();
   file->addAction(tr("&Quit"), QKeySequence::Quit, this, &QWidget::close);
+  return {act_new, act_open, act_save};
+}
+
+// Edit: undo, redo, delete, fit, group, lay out; returns undo, redo and delete for the toolbar.
+QList<QAction*> MainWindow::add_edit_actions(QMenu* edit) {
   QAction* undo = controller_.undo_stack()->createUndoAction(this, tr("&Undo"));
   undo->setShortcut(QKeySequence::Undo);
   QAction* redo = controller_.undo_stack()->createRedoAction(this, tr("&Redo"));
@@ -94,7 +129,11 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     controller_.lay_out();
     canvas_->fit_all();
   });
-  auto* view = menuBar()->addMenu(tr("&View"));
+  return {undo, redo, act_delete};
+}
+
+// View: open a subsystem, show all ports, up from a subsystem.
+void MainWindow::add_view_actions(QMenu* view) {
   view->addAction(tr("&Open subsystem"), QKeySequence(Qt::ALT | Qt::Key_Down), this, [this] {
     const QStringList sel = canvas_->selected_blocks();
     if (sel.size() != 1 || !canvas_->open_subsystem(sel.front()))
@@ -104,17 +143,24 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     for (const QString& b : canvas_->selected_blocks()) canvas_->toggle_all_ports(b);
   });
   view->addAction(tr("&Up from subsystem"), QKeySequence(Qt::ALT | Qt::Key_Up), this, [this] { canvas_->close_subsystem(); });
+}
+
+// Run: run, cancel, modes, frequency response.
+void MainWindow::add_run_actions(QMenu* run_menu) {
   run_action_ = run_menu->addAction(tr("&Run"), QKeySequence(Qt::Key_F5), this, [this] { start_run(); });
   cancel_action_ = run_menu->addAction(tr("&Cancel"), QKeySequence(Qt::Key_Escape), this, [this] { worker_.cancel(); });
   cancel_action_->setEnabled(false);
   run_menu->addSeparator();
   run_menu->addAction(tr("&Modes about the equilibrium"), QKeySequence(Qt::CTRL | Qt::Key_M), this, [this] { start_modes(); });
   run_menu->addAction(tr("&Frequency response"), this, [this] { start_frf(); });
-  for (QAction* a : {act_new, act_open, act_save}) tools->addAction(a);
+}
+
+// The main toolbar: the file and edit actions, run and cancel, the progress bar.
+void MainWindow::fill_main_toolbar(QToolBar* tools, const QList<QAction*>& file_actions,
+                                   const QList<QAction*>& edit_actions) {
+  for (QAction* a : file_actions) tools->addAction(a);
   tools->addSeparator();
-  tools->addAction(undo);
-  tools->addAction(redo);
-  tools->addAction(act_delete);
+  for (QAction* a : edit_actions) tools->addAction(a);
   tools->addSeparator();
   tools->addAction(run_action_);
   tools->addAction(cancel_action_);
@@ -124,8 +170,10 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   progress_->setMaximumWidth(220);
   progress_->setFormat("%p%");
   tools->addWidget(progress_);
+}
 
-  // Where the canvas is: the scene, or the subsystem instances opened; each entry goes back there.
+// The Level toolbar: the find field (Ctrl+F) and the breadcrumb of the levels opened.
+void MainWindow::set_up_level_toolbar() {
   auto* where = addToolBar(tr("Level"));
   where->setObjectName("level_toolbar");
   find_ = new QLineEdit;
@@ -149,10 +197,10 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   });
   connect(canvas_, &Canvas::level_changed, this, &MainWindow::update_breadcrumb);
   update_breadcrumb(canvas_->level());
+}
 
-  status_label_ = new QLabel;
-  statusBar()->addWidget(status_label_, 1);
-
+// The messages, selection, palette, title, run and analysis connections (tabs: the properties tabs).
+void MainWindow::connect_panels(QTabWidget* tabs) {
   connect(canvas_, &Canvas::message, this, &MainWindow::status);
   connect(properties_, &PropertyEditor::message, this, &MainWindow::status);
   connect(scene_panel_, &ScenePanel::message, this, &MainWindow::status);
@@ -178,8 +226,6 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     run_action_->setEnabled(true);
     status(error.isEmpty() ? linear_->message() : tr("analysis failed: %1").arg(error));
   });
-  resize(1500, 950);
-  update_title();
 }
 
 void MainWindow::status(const QString& text) { status_label_->setText(text); }

@@ -7,8 +7,10 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QMainWindow>
+#include <QMenu>
 #include <QProgressBar>
 #include <QTabWidget>
+#include <QToolBar>
 
 #include "gui/canvas.hpp"
 #include "gui/linear_panel.hpp"
@@ -60,6 +62,15 @@ class MainWindow : public QMainWindow {
   void closeEvent(QCloseEvent* e) override;
 
  private:
+  QTabWidget* set_up_docks();
+  void set_up_menus();
+  QList<QAction*> add_file_actions(QMenu* file);
+  QList<QAction*> add_edit_actions(QMenu* edit);
+  void add_view_actions(QMenu* view);
+  void add_run_actions(QMenu* run_menu);
+  void fill_main_toolbar(QToolBar* tools, const QList<QAction*>& file_actions, const QList<QAction*>& edit_actions);
+  void set_up_level_toolbar();
+  void connect_panels(QTabWidget* tabs);
   bool maybe_save();
   void update_title();
   void run_finished(const RunOutcome& outcome);

@@ -62,37 +62,24 @@ void collect_references(const DocBlock& b, std::vector<std::string>& refs) {
         refs.push_back(item.substr(1));
 }
 
-}  // namespace
-
-Grouping group_into_subsystem(const SceneDocument& doc, const std::vector<std::string>& names) {
-  Grouping g;
-  if (names.empty()) {
-    g.error = "select the blocks to group first";
-    return g;
-  }
-  const std::set<std::string> inside(names.begin(), names.end());
+/// Why `names` cannot be grouped ("" when they can): none, one not at the scene's level, or a
+/// `directions:` entry that may name a parameter of one.
+std::string refusal(const SceneDocument& doc, const std::vector<std::string>& names) {
+  if (names.empty()) return "select the blocks to group first";
   for (const std::string& name : names)
-    if (!doc.find_block(name)) {
-      g.error = "no block '" + name + "' at the scene's level";
-      return g;
-    }
+    if (!doc.find_block(name)) return "no block '" + name + "' at the scene's level";
   for (const std::string& path : direction_paths(doc.directions))
     for (const std::string& name : names)
-      if (may_name_block(path, name)) {
-        g.error = "directions: '" + path + "' may name a parameter of " + name +
-                  "; grouping would change what it names: edit the directions first";
-        return g;
-      }
+      if (may_name_block(path, name))
+        return "directions: '" + path + "' may name a parameter of " + name +
+               "; grouping would change what it names: edit the directions first";
+  return {};
+}
 
-  // One name for the definition and the instance, free as both.
-  std::string name = "group";
-  for (int k = 2; doc.find_block(name) || doc.find_subsystem(name); ++k) name = "group" + std::to_string(k);
-  g.instance = name;
-
-  DocSubsystem def;
-  def.name = name;
-  def.description = "grouped from " + std::to_string(names.size()) + " blocks of the scene";
-  std::vector<std::string> refs;
+/// Copies the blocks `inside` into def (moved to the definition's origin) and their scene
+/// parameters into refs; returns the top-left corner they had in the scene.
+std::pair<double, double> copy_blocks(const SceneDocument& doc, const std::set<std::string>& inside,
+                                      DocSubsystem& def, std::vector<std::string>& refs) {
   double left = 1e300, top = 1e300;
   for (const DocBlock& b : doc.blocks)
     if (member(inside, b.name)) {
@@ -106,13 +93,13 @@ Grouping group_into_subsystem(const SceneDocument& doc, const std::vector<std::s
     b.y += kInsideOrigin - top;
     b.placed = true;
   }
+  return {left, top};
+}
 
-  DocBlock instance;
-  instance.name = name;
-  instance.type = std::string(kSubsystemTypePrefix) + name;
-  instance.x = left;
-  instance.y = top;
-  instance.placed = true;
+/// Adds def's parameters and the instance's values passing refs through; returns the
+/// definition's `parameters:` (with the scene's units).
+YAML::Node pass_parameters(const SceneDocument& doc, const std::vector<std::string>& refs, DocSubsystem& def,
+                           DocBlock& instance) {
   // A scene parameter used inside is passed through by a parameter of the same name.
   YAML::Node parameters(YAML::NodeType::Map);
   for (const std::string& ref : refs) {
@@ -123,7 +110,13 @@ Grouping group_into_subsystem(const SceneDocument& doc, const std::vector<std::s
     p.SetStyle(YAML::EmitterStyle::Flow);
     parameters[ref] = p;
   }
+  return parameters;
+}
 
+/// Sorts doc's wires into def's (inside, and its ports) and after's (the rest, through the
+/// instance `name`).
+void split_wires(const SceneDocument& doc, const std::set<std::string>& inside, const std::string& name,
+                 DocSubsystem& def, SceneDocument& after) {
   // Wires: inside stay inside; a wire into the selection is an input port (one per source
   // outside, driving every internal input it drove), one out of it an output port (one per
   // internal source).
@@ -132,8 +125,6 @@ Grouping group_into_subsystem(const SceneDocument& doc, const std::vector<std::s
   const auto find_port = [](auto& list, const PortRef& r) {
     return std::find_if(list.begin(), list.end(), [&](const auto& e) { return e.first == r; });
   };
-  SceneDocument& after = g.after;
-  after = doc;
   after.connections.clear();
   for (const DocConnection& c : doc.connections) {
     const bool from_in = member(inside, c.from.block), to_in = member(inside, c.to.block);
@@ -161,6 +152,10 @@ Grouping group_into_subsystem(const SceneDocument& doc, const std::vector<std::s
       after.connections.push_back(c);
     }
   }
+}
+
+/// The definition's inline YAML: description, parameters, inputs and outputs.
+std::string definition_yaml(const DocSubsystem& def, const YAML::Node& parameters) {
   YAML::Node inputs(YAML::NodeType::Map), outputs(YAML::NodeType::Map);
   for (const auto& [port, targets] : def.inputs) {
     if (targets.size() == 1) {
@@ -178,12 +173,17 @@ Grouping group_into_subsystem(const SceneDocument& doc, const std::vector<std::s
   if (parameters.size() > 0) body["parameters"] = parameters;
   if (inputs.size() > 0) body["inputs"] = inputs;
   if (outputs.size() > 0) body["outputs"] = outputs;
-  def.inline_yaml = YAML::Dump(body);
-  store_inside(def);
+  return YAML::Dump(body);
+}
 
+/// Puts the instance in place of the blocks `inside` and def among after's subsystems, and
+/// renames the outputs and sensitivities of those blocks through the instance.
+void put_instance(const std::set<std::string>& inside, const DocBlock& instance, const DocSubsystem& def,
+                  SceneDocument& after) {
   // The scene: the instance where the blocks were; outputs and directions through it.
   // The instance takes the place of the first block grouped, so that the flattened scene lists
   // its blocks where they were (the engine orders states by the blocks' order).
+  const std::string& name = instance.name;
   const auto first = std::find_if(after.blocks.begin(), after.blocks.end(),
                                   [&](const DocBlock& b) { return member(inside, b.name); });
   *first = instance;
@@ -197,6 +197,42 @@ Grouping group_into_subsystem(const SceneDocument& doc, const std::vector<std::s
     PortRef r;
     if (PortRef::parse(s, r) && member(inside, r.block)) s = name + "." + s;
   }
+}
+
+}  // namespace
+
+Grouping group_into_subsystem(const SceneDocument& doc, const std::vector<std::string>& names) {
+  Grouping g;
+  g.error = refusal(doc, names);
+  if (!g.error.empty()) return g;
+  const std::set<std::string> inside(names.begin(), names.end());
+
+  // One name for the definition and the instance, free as both.
+  std::string name = "group";
+  for (int k = 2; doc.find_block(name) || doc.find_subsystem(name); ++k) name = "group" + std::to_string(k);
+  g.instance = name;
+
+  DocSubsystem def;
+  def.name = name;
+  def.description = "grouped from " + std::to_string(names.size()) + " blocks of the scene";
+  std::vector<std::string> refs;
+  const auto [left, top] = copy_blocks(doc, inside, def, refs);
+
+  DocBlock instance;
+  instance.name = name;
+  instance.type = std::string(kSubsystemTypePrefix) + name;
+  instance.x = left;
+  instance.y = top;
+  instance.placed = true;
+  const YAML::Node parameters = pass_parameters(doc, refs, def, instance);
+
+  SceneDocument& after = g.after;
+  after = doc;
+  split_wires(doc, inside, name, def, after);
+  def.inline_yaml = definition_yaml(def, parameters);
+  store_inside(def);
+
+  put_instance(inside, instance, def, after);
   return g;
 }
 

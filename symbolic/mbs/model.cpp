@@ -203,24 +203,7 @@ class Loader {
       if (!g.IsSequence() || g.size() != 3) fail(g, "gravity", "expected [gx, gy, gz]");
       for (int i = 0; i < 3; ++i) m_.gravity[i] = number(g[i], "gravity");
     }
-    if (const YAML::Node ps = root["parameters"]) {
-      if (!ps.IsMap()) fail(ps, "parameters", "expected a mapping NAME: value");
-      for (const auto& kv : ps) {
-        Parameter p;
-        p.name = kv.first.Scalar();
-        const std::string field = "parameters." + p.name;
-        if (kv.second.IsMap()) {
-          check_keys(kv.second, field, {"value", "fold", "unit"});
-          if (!kv.second["value"]) fail(kv.second, field, "missing value");
-          p.value = number(kv.second["value"], field + ".value");
-          if (kv.second["fold"]) p.symbolic = !boolean(kv.second["fold"], field + ".fold");
-          if (kv.second["unit"]) p.unit = text(kv.second["unit"], field + ".unit");
-        } else {
-          p.value = number(kv.second, field);
-        }
-        m_.parameters.push_back(p);
-      }
-    }
+    if (const YAML::Node ps = root["parameters"]) read_parameters(ps);
     Body ground;
     ground.name = "ground";
     if (const YAML::Node g = root["ground"]) {
@@ -230,84 +213,118 @@ class Loader {
     m_.bodies.push_back(ground);
 
     const YAML::Node bodies = root["bodies"];
-    struct PendingParent {
-      int first_joint;
-      YAML::Node node;
-      std::string field;
-    };
     std::vector<PendingParent> parents;
     if (!bodies || !bodies.IsSequence() || bodies.size() == 0) fail(root, "bodies", "expected a non-empty list");
-    for (std::size_t bi = 0; bi < bodies.size(); ++bi) {
-      const YAML::Node b = bodies[bi];
-      std::string field = "bodies[" + std::to_string(bi) + "]";
-      check_keys(b, field, {"name", "parent", "offset", "joints", "mass", "com", "inertia", "anchors"});
-      Body body;
-      if (!b["name"]) fail(b, field, "missing name");
-      body.name = text(b["name"], field + ".name");
-      field = "bodies." + body.name;
-      for (const Body& other : m_.bodies)
-        if (other.name == body.name) fail(b["name"], field, "duplicate body name");
-      // parents may be declared later: resolved once every body is known
-      if (b["parent"]) parents.push_back({static_cast<int>(m_.joints.size()), b["parent"], field + ".parent"});
-      Vec3Value offset{};
-      if (b["offset"]) offset = vec3(b["offset"], field + ".offset");
-      const YAML::Node js = b["joints"];
-      if (!js || !js.IsSequence() || js.size() == 0) fail(b, field + ".joints", "expected a non-empty list of joints");
-      int parent_joint = -1;
-      for (std::size_t k = 0; k < js.size(); ++k) {
-        const YAML::Node j = js[k];
-        const std::string jf = field + ".joints[" + std::to_string(k) + "]";
-        check_keys(j, jf, {"name", "type", "axis", "driven", "initial"});
-        Joint joint;
-        joint.name = j["name"] ? text(j["name"], jf + ".name") : body.name + "_" + std::to_string(k + 1);
-        for (const Joint& other : m_.joints)
-          if (other.name == joint.name) fail(j, jf + ".name", "duplicate joint name '" + joint.name + "'");
-        if (!j["type"]) fail(j, jf, "missing type (Rx Ry Rz Tx Ty Tz, or R T with an axis)");
-        static const std::map<std::string, JointType> types{{"Rx", JointType::Rx}, {"Ry", JointType::Ry},
-            {"Rz", JointType::Rz}, {"Tx", JointType::Tx}, {"Ty", JointType::Ty}, {"Tz", JointType::Tz},
-            {"R", JointType::R}, {"T", JointType::T}};
-        const auto t = types.find(text(j["type"], jf + ".type"));
-        if (t == types.end()) fail(j["type"], jf + ".type", "expected one of Rx Ry Rz Tx Ty Tz R T");
-        joint.type = t->second;
-        if (axis_of(joint.type) >= 0) {
-          if (j["axis"]) fail(j["axis"], jf + ".axis", "only joints of type R or T take an axis");
-          joint.axis = {0.0, 0.0, 0.0};
-          joint.axis[axis_of(joint.type)] = 1.0;
-        } else {
-          const YAML::Node a = j["axis"];
-          if (!a) fail(j, jf + ".axis", "missing (a joint of type R or T needs an axis [x, y, z])");
-          if (!a.IsSequence() || a.size() != 3) fail(a, jf + ".axis", "expected [x, y, z]");
-          double norm = 0.0;
-          for (int i = 0; i < 3; ++i) {
-            joint.axis[i] = number(a[i], jf + ".axis");
-            norm += joint.axis[i] * joint.axis[i];
-          }
-          if (norm < 1e-24) fail(a, jf + ".axis", "the axis is zero");
-          for (double& c : joint.axis) c /= std::sqrt(norm);
-        }
-        joint.parent = parent_joint;
-        if (k == 0) joint.offset = offset;
-        if (j["driven"]) joint.driven = boolean(j["driven"], jf + ".driven");
-        if (j["initial"]) joint.initial = number(j["initial"], jf + ".initial");
-        m_.joints.push_back(joint);
-        parent_joint = static_cast<int>(m_.joints.size()) - 1;
-      }
-      body.frame = parent_joint;
-      m_.joints[parent_joint].body = static_cast<int>(m_.bodies.size());
-      if (!b["mass"]) fail(b, field + ".mass", "missing");
-      body.mass = value(b["mass"], field + ".mass");
-      if (b["com"]) body.com = vec3(b["com"], field + ".com");
-      if (const YAML::Node in = b["inertia"]) {
-        if (!in.IsSequence() || (in.size() != 3 && in.size() != 6))
-          fail(in, field + ".inertia", "expected [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]");
-        for (std::size_t i = 0; i < in.size(); ++i) body.inertia[i] = value(in[i], field + ".inertia");
-      }
-      anchors(b["anchors"], body, field + ".anchors");
-      m_.bodies.push_back(body);
-    }
+    for (std::size_t bi = 0; bi < bodies.size(); ++bi) read_body(bodies[bi], bi, parents);
 
     for (const auto& [first_joint, node, field] : parents)
       m_.joints[first_joint].parent = m_.bodies[body_index(node, text(node, field), field)].frame;
+    order_joints(bodies);
+  }
+
+  // The `parameters:` mapping, NAME: value or NAME: {value, fold, unit}.
+  void read_parameters(const YAML::Node& ps) {
+    if (!ps.IsMap()) fail(ps, "parameters", "expected a mapping NAME: value");
+    for (const auto& kv : ps) {
+      Parameter p;
+      p.name = kv.first.Scalar();
+      const std::string field = "parameters." + p.name;
+      if (kv.second.IsMap()) {
+        check_keys(kv.second, field, {"value", "fold", "unit"});
+        if (!kv.second["value"]) fail(kv.second, field, "missing value");
+        p.value = number(kv.second["value"], field + ".value");
+        if (kv.second["fold"]) p.symbolic = !boolean(kv.second["fold"], field + ".fold");
+        if (kv.second["unit"]) p.unit = text(kv.second["unit"], field + ".unit");
+      } else {
+        p.value = number(kv.second, field);
+      }
+      m_.parameters.push_back(p);
+    }
+  }
+
+  // A body's `parent:`, resolved once every body is known.
+  struct PendingParent {
+    int first_joint;
+    YAML::Node node;
+    std::string field;
+  };
+
+  // Body bi of `bodies:` with its joints (appended to m_.joints), its parent left in `parents`.
+  void read_body(const YAML::Node& b, std::size_t bi, std::vector<PendingParent>& parents) {
+    std::string field = "bodies[" + std::to_string(bi) + "]";
+    check_keys(b, field, {"name", "parent", "offset", "joints", "mass", "com", "inertia", "anchors"});
+    Body body;
+    if (!b["name"]) fail(b, field, "missing name");
+    body.name = text(b["name"], field + ".name");
+    field = "bodies." + body.name;
+    for (const Body& other : m_.bodies)
+      if (other.name == body.name) fail(b["name"], field, "duplicate body name");
+    // parents may be declared later: resolved once every body is known
+    if (b["parent"]) parents.push_back({static_cast<int>(m_.joints.size()), b["parent"], field + ".parent"});
+    Vec3Value offset{};
+    if (b["offset"]) offset = vec3(b["offset"], field + ".offset");
+    const YAML::Node js = b["joints"];
+    if (!js || !js.IsSequence() || js.size() == 0) fail(b, field + ".joints", "expected a non-empty list of joints");
+    int parent_joint = -1;
+    for (std::size_t k = 0; k < js.size(); ++k) {
+      const std::string jf = field + ".joints[" + std::to_string(k) + "]";
+      Joint joint = read_joint(js[k], jf, body.name + "_" + std::to_string(k + 1));
+      joint.parent = parent_joint;
+      if (k == 0) joint.offset = offset;
+      m_.joints.push_back(joint);
+      parent_joint = static_cast<int>(m_.joints.size()) - 1;
+    }
+    body.frame = parent_joint;
+    m_.joints[parent_joint].body = static_cast<int>(m_.bodies.size());
+    if (!b["mass"]) fail(b, field + ".mass", "missing");
+    body.mass = value(b["mass"], field + ".mass");
+    if (b["com"]) body.com = vec3(b["com"], field + ".com");
+    if (const YAML::Node in = b["inertia"]) {
+      if (!in.IsSequence() || (in.size() != 3 && in.size() != 6))
+        fail(in, field + ".inertia", "expected [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]");
+      for (std::size_t i = 0; i < in.size(); ++i) body.inertia[i] = value(in[i], field + ".inertia");
+    }
+    anchors(b["anchors"], body, field + ".anchors");
+    m_.bodies.push_back(body);
+  }
+
+  // A joint's name (`unnamed` when it has none), type, axis, driven and initial (jf: its field).
+  Joint read_joint(const YAML::Node& j, const std::string& jf, const std::string& unnamed) const {
+    check_keys(j, jf, {"name", "type", "axis", "driven", "initial"});
+    Joint joint;
+    joint.name = j["name"] ? text(j["name"], jf + ".name") : unnamed;
+    for (const Joint& other : m_.joints)
+      if (other.name == joint.name) fail(j, jf + ".name", "duplicate joint name '" + joint.name + "'");
+    if (!j["type"]) fail(j, jf, "missing type (Rx Ry Rz Tx Ty Tz, or R T with an axis)");
+    static const std::map<std::string, JointType> types{{"Rx", JointType::Rx}, {"Ry", JointType::Ry},
+        {"Rz", JointType::Rz}, {"Tx", JointType::Tx}, {"Ty", JointType::Ty}, {"Tz", JointType::Tz},
+        {"R", JointType::R}, {"T", JointType::T}};
+    const auto t = types.find(text(j["type"], jf + ".type"));
+    if (t == types.end()) fail(j["type"], jf + ".type", "expected one of Rx Ry Rz Tx Ty Tz R T");
+    joint.type = t->second;
+    if (axis_of(joint.type) >= 0) {
+      if (j["axis"]) fail(j["axis"], jf + ".axis", "only joints of type R or T take an axis");
+      joint.axis = {0.0, 0.0, 0.0};
+      joint.axis[axis_of(joint.type)] = 1.0;
+    } else {
+      const YAML::Node a = j["axis"];
+      if (!a) fail(j, jf + ".axis", "missing (a joint of type R or T needs an axis [x, y, z])");
+      if (!a.IsSequence() || a.size() != 3) fail(a, jf + ".axis", "expected [x, y, z]");
+      double norm = 0.0;
+      for (int i = 0; i < 3; ++i) {
+        joint.axis[i] = number(a[i], jf + ".axis");
+        norm += joint.axis[i] * joint.axis[i];
+      }
+      if (norm < 1e-24) fail(a, jf + ".axis", "the axis is zero");
+      for (double& c : joint.axis) c /= std::sqrt(norm);
+    }
+    if (j["driven"]) joint.driven = boolean(j["driven"], jf + ".driven");
+    if (j["initial"]) joint.initial = number(j["initial"], jf + ".initial");
+    return joint;
+  }
+
+  // m_.order from the joints' parents; a loop among them is an error at `bodies`.
+  void order_joints(const YAML::Node& bodies) {
     // Joints in an order where parents come first (coordinates keep the declaration order).
     std::vector<int> state(m_.joints.size(), 0);  // 0 new, 1 visiting, 2 done
     std::function<void(int)> visit = [&](int j) {

@@ -166,9 +166,8 @@ void ReducedDynamics::predict(const Result& r, const double* u, Vector& guess) c
 }
 
 void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, Result& r) const {
-  const int n = model_.n, m = model_.m, nu = this->nu();
+  const int n = model_.n, m = model_.m;
   const double* p = params(p_in);
-  const double* lam0 = pad_.data();
   Result::Work& w = r.work;
   if (static_cast<int>(w.lam_zero.size()) != std::max(1, m)) w.lam_zero.assign(std::max(1, m), 0.0);
   const double* in = model_.inputs ? inputs : pad_.data();
@@ -178,8 +177,30 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   // c (with the driven accelerations) and the constraint bias.
   w.res.resize(n + m);
   model_.residual(r.q.data(), r.qd.data(), r.qdd.data(), w.lam_zero.data(), in, p, w.res.data());
-  const Eigen::Map<const Vector> c(w.res.data(), n), a0(w.res.data() + n, m);
+  const double* c = w.res.data();
+  const double* a0 = w.res.data() + n;
 
+  const int nf = static_cast<int>(f_.size());
+  free_basis(a0, r);
+
+  // a tree (no constraints, u in coordinate order): B = I, M B = M, and the products would cost
+  // two dense n^3 products
+  const bool identity = m == 0 && u_ == f_;
+  // M [B beta]: M qdd for qdd = B udd + beta is all we need.
+  if (model_.mass_matrix) gathered_mass_basis(in, p, r);
+  else seeded_mass_basis(in, p, r);
+
+  const bool whole = identity && nf == n;  // no driven joints either: M_ff B is M
+  factor_reduced(c, identity, whole, r);
+  free_accelerations(identity, r);
+  multipliers(c, r);
+  r.dynamics_current = true;
+}
+
+// B over the free coordinates and beta, the free accelerations at udd = 0 (a0: the constraint bias).
+void ReducedDynamics::free_basis(const double* a0, Result& r) const {
+  const int n = model_.n, m = model_.m, nu = this->nu();
+  Result::Work& w = r.work;
   const int nf = static_cast<int>(f_.size());
   // B over the free coordinates: rows u (identity) and v (-Jv^-1 Ju).
   // B's and M [B beta]'s entries outside their structure, and B's independent rows' 1s, are
@@ -215,53 +236,63 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
       }
     }
     w.beta_v.resize(m, 1);
-    r.Jv.solve(a0.data(), m, 1, w.beta_v.data(), m);
+    r.Jv.solve(a0, m, 1, w.beta_v.data(), m);
     for (const auto& [a, place] : dependent_rows_) w.beta[a] = -w.beta_v(place, 0);
   }
+}
 
-  // a tree (no constraints, u in coordinate order): B = I, M B = M, and the products would cost
-  // two dense n^3 products
-  const bool identity = m == 0 && u_ == f_;
-  // M [B beta]: M qdd for qdd = B udd + beta is all we need.
-  if (model_.mass_matrix) {
-    // M's structurally nonzero entries by composite inertias times the structurally nonzero
-    // entries of [B beta]: a corner's rows meet a corner's two or three columns
-    w.mass.resize(model_.mass_entries + 1);
-    model_.mass_matrix(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, w.mass.data());
-    w.mass[model_.mass_entries] = 0.0;
-    w.s_val.resize(s_col_.size());  // (the dependent rows': the independent ones' 1 is not read)
-    for (const auto& [a, place] : dependent_rows_) {
-      const int j = f_[a];
-      for (int t = s_start_[j]; t < s_start_[j + 1]; ++t) w.s_val[t] = s_col_[t] < nu ? r.B(a, s_col_[t]) : w.beta[a];
-    }
-    double* __restrict mb = r.MB.data();
-    const double* mass = w.mass.data();
-    const double* val = w.s_val.data();
-    const int* start = mb_start_.data();
-    const int* at_mass = mb_mass_.data();
-    const int* at_s = mb_s_.data();
-    const int* at_unit = mb_unit_.data();
-    for (std::size_t o = 0; o < mb_place_.size(); ++o) {
-      double sum = mass[at_unit[o]];
-      for (int t = start[o]; t < start[o + 1]; ++t) sum += mass[at_mass[t]] * val[at_s[t]];
-      mb[mb_place_[o]] = sum;
-    }
-  } else {
-    // the inertial pass seeded on [B beta] (nu + 1 directions; M itself, n directions, is never
-    // formed): a tree too deep for M's entries
-    r.seeds.setZero(n, k);  // kept in r: a large tree's n x n blocks would be fresh pages each call
-    for (int a = 0; a < nf; ++a) {
-      r.seeds.row(f_[a]).head(nu) = r.B.row(a);
-      if (m > 0) r.seeds(f_[a], nu) = w.beta[a];
-    }
-    w.out.resize(n);
-    w.mass_columns.resize(n, k);
-    model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), lam0, in, p, k, r.seeds.data(), w.out.data(),
-                w.mass_columns.data());
-    r.MB = w.mass_columns;
+// r.MB = M [B beta] from M's structurally nonzero entries (the model's mass_matrix).
+void ReducedDynamics::gathered_mass_basis(const double* in, const double* p, Result& r) const {
+  const int nu = this->nu();
+  Result::Work& w = r.work;
+  // M's structurally nonzero entries by composite inertias times the structurally nonzero
+  // entries of [B beta]: a corner's rows meet a corner's two or three columns
+  w.mass.resize(model_.mass_entries + 1);
+  model_.mass_matrix(r.q.data(), r.qd.data(), r.qdd.data(), pad_.data(), in, p, w.mass.data());
+  w.mass[model_.mass_entries] = 0.0;
+  w.s_val.resize(s_col_.size());  // (the dependent rows': the independent ones' 1 is not read)
+  for (const auto& [a, place] : dependent_rows_) {
+    const int j = f_[a];
+    for (int t = s_start_[j]; t < s_start_[j + 1]; ++t) w.s_val[t] = s_col_[t] < nu ? r.B(a, s_col_[t]) : w.beta[a];
   }
+  double* __restrict mb = r.MB.data();
+  const double* mass = w.mass.data();
+  const double* val = w.s_val.data();
+  const int* start = mb_start_.data();
+  const int* at_mass = mb_mass_.data();
+  const int* at_s = mb_s_.data();
+  const int* at_unit = mb_unit_.data();
+  for (std::size_t o = 0; o < mb_place_.size(); ++o) {
+    double sum = mass[at_unit[o]];
+    for (int t = start[o]; t < start[o + 1]; ++t) sum += mass[at_mass[t]] * val[at_s[t]];
+    mb[mb_place_[o]] = sum;
+  }
+}
 
-  const bool whole = identity && nf == n;  // no driven joints either: M_ff B is M
+// r.MB = M [B beta] by the model's inertial pass seeded on [B beta] (no mass_matrix).
+void ReducedDynamics::seeded_mass_basis(const double* in, const double* p, Result& r) const {
+  const int n = model_.n, m = model_.m, nu = this->nu();
+  const int nf = static_cast<int>(f_.size()), k = nu + (m > 0 ? 1 : 0);
+  Result::Work& w = r.work;
+  // the inertial pass seeded on [B beta] (nu + 1 directions; M itself, n directions, is never
+  // formed): a tree too deep for M's entries
+  r.seeds.setZero(n, k);  // kept in r: a large tree's n x n blocks would be fresh pages each call
+  for (int a = 0; a < nf; ++a) {
+    r.seeds.row(f_[a]).head(nu) = r.B.row(a);
+    if (m > 0) r.seeds(f_[a], nu) = w.beta[a];
+  }
+  w.out.resize(n);
+  w.mass_columns.resize(n, k);
+  model_.mass(r.q.data(), r.qd.data(), r.qdd.data(), pad_.data(), in, p, k, r.seeds.data(), w.out.data(),
+              w.mass_columns.data());
+  r.MB = w.mass_columns;
+}
+
+// M_ff B, M beta and c over the free rows, and the Cholesky factor of B^T M_ff B (c: the residual's n entries).
+void ReducedDynamics::factor_reduced(const double* c, bool identity, bool whole, Result& r) const {
+  const int n = model_.n, m = model_.m, nu = this->nu();
+  const int nf = static_cast<int>(f_.size());
+  Result::Work& w = r.work;
   w.Mbeta.resize(nf);
   w.cf.resize(nf);
   if (!whole) r.MBf.resize(nf, nu);  // M_ff B
@@ -291,6 +322,13 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   }
   if (!definite)
     throw std::runtime_error(std::string(model_.name) + ": reduced mass matrix is not positive definite");
+}
+
+// udd from the reduced system, and the free coordinates' accelerations qdd = B udd + beta.
+void ReducedDynamics::free_accelerations(bool identity, Result& r) const {
+  const int nu = this->nu();
+  const int nf = static_cast<int>(f_.size());
+  Result::Work& w = r.work;
   w.cf += w.Mbeta;
   if (identity) {
     r.udd = w.cf;
@@ -305,7 +343,12 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
   for (int a = 0; a < nf; ++a)
     for (int c : b_cols_[a]) w.qddf[a] += r.B(a, c) * r.udd[c];
   for (int a = 0; a < nf; ++a) r.qdd[f_[a]] = w.qddf[a];
+}
 
+// The multipliers lam from the dependent rows (c: the residual's n entries).
+void ReducedDynamics::multipliers(const double* c, Result& r) const {
+  const int m = model_.m, nu = this->nu();
+  Result::Work& w = r.work;
   // Multipliers: J^T lam = M qdd + c on the dependent rows, M qdd = M B udd + M beta.
   r.lam.resize(m);
   if (m > 0) {  // (the dependent rows only)
@@ -313,7 +356,6 @@ void ReducedDynamics::solve_dynamics(const double* inputs, const double* p_in, R
     for (int i = 0; i < m; ++i) w.fv[i] = c[v_[i]] + r.MB(v_[i], nu) + r.MB.row(v_[i]).head(nu).dot(r.udd);
     r.Jv.transpose_solve(w.fv.data(), m, 1, r.lam.data(), m);
   }
-  r.dynamics_current = true;
 }
 
 void ReducedDynamics::seed_arrays(int nd, const double* dinputs, const double* dp_in, Matrix& dinp, Matrix& dp,

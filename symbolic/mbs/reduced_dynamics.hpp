@@ -96,6 +96,16 @@ class ReducedDynamics {
 
  private:
   const double* params(const double* p) const { return p ? p : (model_.parameters ? model_.parameter_values : pad_.data()); }
+  // solve_dynamics() in its steps, in this order, over r's scratch storage. B and beta (a0: the
+  // constraint bias); M [B beta] into r.MB from M's entries or by the seeded inertial pass; M_ff B,
+  // M beta, c over the free rows and the factor of B^T M_ff B (c: the residual's n entries); udd and
+  // the free rows of qdd; the multipliers.
+  void free_basis(const double* a0, Result& r) const;
+  void gathered_mass_basis(const double* in, const double* p, Result& r) const;
+  void seeded_mass_basis(const double* in, const double* p, Result& r) const;
+  void factor_reduced(const double* c, bool identity, bool whole, Result& r) const;
+  void free_accelerations(bool identity, Result& r) const;
+  void multipliers(const double* c, Result& r) const;
   // The input and parameter seeds as padded matrices (null: zero), and dqdd seeded on the
   // driven joints' accelerations.
   void seed_arrays(int nd, const double* dinputs, const double* dp, Matrix& dinp, Matrix& dp_out,
