@@ -7,18 +7,19 @@
 #include <utility>
 
 #include "symbolic/eliminate.hpp"
+#include "symbolic/node_builder.hpp"
 
 namespace dydp::symbolic {
 namespace {
 
 constexpr NodeId kUnset = 0xFFFFFFFFu;
 
-class Differentiator {
+class Differentiator : NodeBuilder {
  public:
   // `list`, `suffix`: where the derivatives of the sin/cos abbreviations are assigned (see
   // compute()); null: they stay expressions.
   Differentiator(Context& ctx, std::size_t known_nodes, EquationList* list = nullptr, std::string suffix = "")
-      : ctx_(ctx), derivative_(known_nodes, kUnset),
+      : NodeBuilder(ctx), derivative_(known_nodes, kUnset),
         zero_(ctx.constant(0.0).id()), one_(ctx.constant(1.0).id()), list_(list), suffix_(std::move(suffix)) {}
 
   void set(NodeId symbol, NodeId derivative) { derivative_.at(symbol) = derivative; }
@@ -33,13 +34,6 @@ class Differentiator {
   }
 
  private:
-  NodeId add(NodeId a, NodeId b) { const NodeId k[2] = {a, b}; return ctx_.make(Op::Add, k); }
-  NodeId sub(NodeId a, NodeId b) { return add(a, neg(b)); }
-  NodeId mul(NodeId a, NodeId b) { const NodeId k[2] = {a, b}; return ctx_.make(Op::Mul, k); }
-  NodeId div(NodeId a, NodeId b) { const NodeId k[2] = {a, b}; return ctx_.make(Op::Div, k); }
-  NodeId neg(NodeId a) { return ctx_.make(Op::Neg, std::span<const NodeId>(&a, 1)); }
-  NodeId fn(Op op, NodeId a) { return ctx_.make(op, std::span<const NodeId>(&a, 1)); }
-  NodeId constant(double v) { return ctx_.constant(v).id(); }
 
   NodeId compute(NodeId n) {
     const Op op = ctx_.op(n);
@@ -125,7 +119,6 @@ class Differentiator {
     }
   }
 
-  Context& ctx_;
   std::vector<NodeId> derivative_;
   NodeId zero_, one_;
   EquationList* list_;

@@ -16,17 +16,18 @@
 #include <vector>
 
 #include "symbolic/eliminate.hpp"
+#include "symbolic/node_builder.hpp"
 
 namespace dydp::symbolic {
 namespace {
 
 constexpr std::uint32_t kNone = 0xFFFFFFFFu;
 
-class Adjoint {
+class Adjoint : NodeBuilder {
  public:
   // `known_nodes`: the context's size when the primal list was complete (every node it reads).
   Adjoint(Context& ctx, EquationList& out, std::size_t known_nodes)
-      : ctx_(ctx), out_(out), active_(known_nodes, 0), stamp_(known_nodes, 0), position_(known_nodes, kNone),
+      : NodeBuilder(ctx), out_(out), active_(known_nodes, 0), stamp_(known_nodes, 0), position_(known_nodes, kNone),
         search_(ctx), first_root_(known_nodes, kNone), shared_(known_nodes, 0), zero_(ctx.constant(0.0).id()),
         one_(ctx.constant(1.0).id()) {}
 
@@ -131,14 +132,6 @@ class Adjoint {
     for (NodeId n : nodes) position_[n] = kNone;
   }
 
-  NodeId add(NodeId a, NodeId b) { const NodeId k[2] = {a, b}; return ctx_.make(Op::Add, k); }
-  NodeId sub(NodeId a, NodeId b) { return add(a, neg(b)); }
-  NodeId mul(NodeId a, NodeId b) { const NodeId k[2] = {a, b}; return ctx_.make(Op::Mul, k); }
-  NodeId div(NodeId a, NodeId b) { const NodeId k[2] = {a, b}; return ctx_.make(Op::Div, k); }
-  NodeId neg(NodeId a) { return ctx_.make(Op::Neg, std::span<const NodeId>(&a, 1)); }
-  NodeId fn(Op op, NodeId a) { return ctx_.make(op, std::span<const NodeId>(&a, 1)); }
-  NodeId constant(double v) { return ctx_.constant(v).id(); }
-  NodeId select(NodeId c, NodeId a, NodeId b) { const NodeId k[3] = {c, a, b}; return ctx_.make(Op::Select, k); }
   // An adjoint read more than once: an auxiliary, unless trivial.
   NodeId share(NodeId value, const std::string& name) { return out_.assign(name, ctx_.expr(value)).id(); }
 
@@ -283,7 +276,6 @@ class Adjoint {
     }
   }
 
-  Context& ctx_;
   EquationList& out_;
   enum Activity : char { kUnknown, kInactive, kActive };
   std::vector<char> active_;             // by node (symbols and nodes above them; see active())
