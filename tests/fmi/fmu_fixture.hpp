@@ -12,6 +12,7 @@
 #include <fstream>
 #include <memory>
 #include <numbers>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -74,6 +75,17 @@ inline std::string damper_sensitivity_description(bool without_inputs) {
 inline double rig_stroke(double t) { return 0.02 * std::sin(2 * std::numbers::pi * 2.0 * t + 0.0); }
 inline double rig_stroke_rate(double t) {
   return 0.25132741228718347 * std::sin(2 * std::numbers::pi * 2.0 * t + 1.5707963267948966);
+}
+
+/// A copy of `scene` in this test program's FMU folder, named `name`, that starts at its static
+/// equilibrium (`initial: equilibrium` added); returns its path.
+inline std::string scene_at_equilibrium(const std::string& scene, const std::string& name) {
+  std::ifstream in(scene);
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string copy = (FmuFolder::path() / name).string();
+  std::ofstream(copy) << text.str() << "initial: equilibrium\n";
+  return copy;
 }
 
 /// Largest |a - b| over a column, relative to the column's largest |b| (floor `tiny`).

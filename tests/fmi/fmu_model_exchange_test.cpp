@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <ctime>
 #include <fstream>
-#include <sstream>
 #include <random>
 
 #include "engine/evaluation/evaluator.hpp"
@@ -341,11 +340,7 @@ TEST_P(ModelExchange, DirectionalAndAdjointDerivativesAreTheTangents) {
 TEST(ModelExchangeEquilibrium, ASceneThatStartsAtItsEquilibriumStartsThereWithTheImportersInputs) {
   // The CDC damper's FMU with its rig scene starting at `initial: equilibrium`: the hydraulics'
   // steady state at the stroke and stroke rate the importer sets before initialisation ends.
-  std::ifstream in(kDamperRig);
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::string rig = (FmuFolder::path() / "cdc_damper_rig_at_rest.yaml").string();
-  std::ofstream(rig) << text.str() << "initial: equilibrium\n";
+  const std::string rig = scene_at_equilibrium(kDamperRig, "cdc_damper_rig_at_rest.yaml");
   const std::string description = (FmuFolder::path() / "cdc_damper_at_rest.yml").string();
   std::ofstream(description) << "fmu: cdc_damper_at_rest\nscene: cdc_damper_rig_at_rest.yaml\n"
                                 "inputs: [stroke.y, stroke_rate.y]\noutputs: [damper.force]\n"

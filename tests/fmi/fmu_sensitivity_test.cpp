@@ -10,7 +10,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
 
 #include "engine/analysis/run.hpp"
 #include "engine/framework/diagram.hpp"
@@ -131,11 +130,7 @@ TEST(CoSimulationSensitivities, DamperSensitivitiesMatchTheNativeRunWithinItsOwn
 
 TEST(CoSimulationSensitivities, FromTheEquilibriumTheyStartAtItsDerivatives) {
   // The rig starting at `initial: equilibrium`: the sensitivities start at the equilibrium's dx/dp.
-  std::ifstream in(kDamperRig);
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::string rig = (FmuFolder::path() / "cdc_damper_rig_sens_at_rest.yaml").string();
-  std::ofstream(rig) << text.str() << "initial: equilibrium\n";
+  const std::string rig = scene_at_equilibrium(kDamperRig, "cdc_damper_rig_sens_at_rest.yaml");
   const std::string description = (FmuFolder::path() / "cdc_damper_sens_at_rest.yml").string();
   std::ofstream(description) << "fmu: cdc_damper_sens_at_rest\nscene: cdc_damper_rig_sens_at_rest.yaml\n"
                                 "outputs: [damper.force, damper.p_rebound, damper.p_compression, damper.power]\n"
