@@ -210,17 +210,6 @@ class AdjointRun {
   }
 
   // CVODES' counters of one forward problem added to the run's statistics.
-  void add_forward_stats(void* mem) {
-    RunStats& st = result_.stats;
-    long v = 0;
-    CVodeGetNumSteps(mem, &v), st.steps += v;
-    CVodeGetNumRhsEvals(mem, &v), st.rhs_evals += v;
-    CVodeGetNumErrTestFails(mem, &v), st.error_test_failures += v;
-    CVodeGetNumNonlinSolvIters(mem, &v), st.nonlinear_iterations += v;
-    CVodeGetNumNonlinSolvConvFails(mem, &v), st.nonlinear_failures += v;
-    if (bdf_) CVodeGetNumJacEvals(mem, &v), st.jac_evals += v;
-  }
-
   // The forward run over every segment, cut into chunks, and its statistics.
   void first_pass() {
     const bool backward = nm_ > 0 && ns_ > 0;
@@ -245,7 +234,7 @@ class AdjointRun {
         CVodeGetNumSteps(S->mem, &steps);
         if (backward && steps >= chunk_steps && target < c.segment_stop) {
           c.steps = steps;
-          add_forward_stats(S->mem);
+          add_cvodes_counters(S->mem, bdf_, result_.stats);
           chunks_.push_back(c);
           c.start = target;
           c.targets.clear();
@@ -255,7 +244,7 @@ class AdjointRun {
         }
       }
       CVodeGetNumSteps(S->mem, &c.steps);
-      add_forward_stats(S->mem);
+      add_cvodes_counters(S->mem, bdf_, result_.stats);
       if (!c.targets.empty()) chunks_.push_back(std::move(c));
     }
     RunStats& st = result_.stats;
@@ -306,7 +295,6 @@ class AdjointRun {
     const std::vector<double> nominal = state_nominals(d_);
     lambda_ = OwnedVector(N_VNew_Serial(std::max(nb_, 1), C_.ctx));
     atol_b_ = OwnedVector(N_VNew_Serial(std::max(nb_, 1), C_.ctx));
-    grad_ = OwnedVector(N_VNew_Serial(ns_ * nm_, C_.ctx));
     atol_q_ = OwnedVector(N_VNew_Serial(ns_ * nm_, C_.ctx));
     N_VConst(0.0, lambda_.v);
     N_VConst(d_.solver.atol, atol_b_.v);
@@ -436,7 +424,7 @@ class AdjointRun {
   std::vector<double> q_;       // the objective integrals at the end
   Backward B_;
   int nb_ = 0;                  // lambda's entries: nx per objective
-  OwnedVector lambda_, atol_b_, grad_, atol_q_, qB_;
+  OwnedVector lambda_, atol_b_, atol_q_, qB_;
   std::vector<double> gradient_;  // d(psi_m)/dp: ns x nm
   long most_steps_ = 0;           // the most steps stored for a chunk
 };

@@ -172,6 +172,16 @@ void set_up_forward(Problem& P, void* mem, SUNContext ctx, double t, N_Vector y,
   }
 }
 
+void add_cvodes_counters(void* mem, bool bdf, RunStats& st) {
+  long v = 0;
+  CVodeGetNumSteps(mem, &v), st.steps += v;
+  CVodeGetNumRhsEvals(mem, &v), st.rhs_evals += v;
+  CVodeGetNumErrTestFails(mem, &v), st.error_test_failures += v;
+  CVodeGetNumNonlinSolvIters(mem, &v), st.nonlinear_iterations += v;
+  CVodeGetNumNonlinSolvConvFails(mem, &v), st.nonlinear_failures += v;
+  if (bdf) CVodeGetNumJacEvals(mem, &v), st.jac_evals += v;
+}
+
 void finish_cvodes_stats(RunStats& st, const Diagram& d, double cpu_seconds) {
   st.rtol = d.solver.rtol;
   st.atol = d.solver.atol;

@@ -149,6 +149,11 @@ struct ForwardSolvers {
 /// kLocalRefreshSetupSteps steps then), for Adams the fixed-point iteration.
 void set_up_forward(Problem& P, void* mem, SUNContext ctx, double t, N_Vector y, N_Vector atol, ForwardSolvers& s);
 
+/// CVODES' counters of the integration in `mem` (steps, right-hand sides, error test failures,
+/// Newton iterations and failures, for BDF Jacobians) added to st: once per segment, since a
+/// restart or a new solver starts them again.
+void add_cvodes_counters(void* mem, bool bdf, RunStats& st);
+
 /// The run's statistics at its end: the tolerances, the highest order and the CPU time.
 void finish_cvodes_stats(RunStats& st, const Diagram& d, double cpu_seconds);
 

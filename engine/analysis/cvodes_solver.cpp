@@ -136,13 +136,7 @@ class CvodesRun {
   // CVODES' counters of the segment just integrated added to the run's statistics.
   void accumulate() {
     RunStats& st = result_.stats;
-    long v = 0;
-    CVodeGetNumSteps(S_.mem, &v), st.steps += v;
-    CVodeGetNumRhsEvals(S_.mem, &v), st.rhs_evals += v;
-    CVodeGetNumErrTestFails(S_.mem, &v), st.error_test_failures += v;
-    CVodeGetNumNonlinSolvIters(S_.mem, &v), st.nonlinear_iterations += v;
-    CVodeGetNumNonlinSolvConvFails(S_.mem, &v), st.nonlinear_failures += v;
-    if (bdf_) CVodeGetNumJacEvals(S_.mem, &v), st.jac_evals += v;
+    add_cvodes_counters(S_.mem, bdf_, st);
     st.local_jac_evals = P_.local_refreshes;
     st.jacobian_colours = P_.colouring.colours();
   }
